@@ -1,0 +1,55 @@
+# drape: the two set-up commands are `make demo` and `make test`; each installs what is missing.
+BUILD    ?= build
+JOBS     ?= $(shell nproc)
+WERROR   ?= OFF
+CMAKE_FLAGS ?=
+
+.PHONY: all deps configure build demo test bench fuzz sanitize format tidy clean
+
+all: build
+
+deps:
+	@./tools/install-deps.sh
+
+$(BUILD)/CMakeCache.txt:
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DDRAPE_WERROR=$(WERROR) $(CMAKE_FLAGS)
+
+configure: $(BUILD)/CMakeCache.txt
+
+build: deps configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+# The main job on the embedded defaults: dress the default body, write ./out/.
+demo: build
+	$(BUILD)/drape dress --out out
+	@echo "demo: wrote out/dressed.glb, out/preview.png, out/report.json"
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	@for b in $(BUILD)/bench_*; do echo "== $$b"; $$b --benchmark_counters_tabular=true || exit 1; done
+
+# Tests under AddressSanitizer + UndefinedBehaviorSanitizer in their own build directory.
+sanitize: deps
+	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_SANITIZE=address,undefined \
+	  -DDRAPE_BENCH=OFF -DDRAPE_WERROR=$(WERROR) $(CMAKE_FLAGS)
+	cmake --build build-asan -j $(JOBS)
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 DRAPE_SANITIZED=1 \
+	  ctest --output-on-failure -j $(JOBS)
+
+# libFuzzer targets, one per parser (clang-14), in build-fuzz/.
+fuzz: deps
+	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_FUZZ=ON \
+	  -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14
+	cmake --build build-fuzz -j $(JOBS)
+	@echo "fuzz targets: build-fuzz/fuzz_*  (run e.g. build-fuzz/fuzz_obj -max_total_time=60 tests/corpus/info)"
+
+format:
+	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
+
+tidy: configure
+	run-clang-tidy -p $(BUILD) -quiet $$(git ls-files 'src/*.cpp' 'app/*.cpp') || clang-tidy -p $(BUILD) $$(git ls-files 'src/*.cpp' 'app/*.cpp')
+
+clean:
+	rm -rf $(BUILD) build-asan build-fuzz

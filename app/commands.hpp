@@ -1,0 +1,17 @@
+#pragma once
+// Each `drape` subcommand lives in its own file app/cmd_<name>.cpp and registers itself here.
+#include <CLI/CLI.hpp>
+
+namespace drape::app {
+
+// Options every command that loads meshes shares (DESIGN.md: units and axes are never guessed).
+struct LoadOptions {
+  std::string units = "m";  // mm|cm|dm|m
+  std::string up = "y";     // y|z
+};
+void add_load_options(CLI::App& cmd, LoadOptions& opts);
+
+void add_info_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
+
+}  // namespace drape::app

@@ -1,0 +1,31 @@
+#pragma once
+// Helpers shared by all test executables: where the real-data fixtures and the CLI are,
+// and running the CLI as a user would.
+#include <filesystem>
+#include <string>
+
+namespace drape::test {
+
+// ../shared/data (absolute), or an empty path when it is absent (a user's fresh clone).
+std::filesystem::path shared_data();
+// Path of a file under ../shared/data; the calling test is skipped when it is missing.
+#define DRAPE_REQUIRE_SHARED(rel)                                                              \
+  ([&]() {                                                                                     \
+    auto p = ::drape::test::shared_data() / (rel);                                             \
+    if (::drape::test::shared_data().empty() || !std::filesystem::exists(p))                   \
+      GTEST_SKIP() << "shared test data not found: " << p << " (needs ../shared/data)";        \
+    return p;                                                                                  \
+  }())
+
+// A fresh empty directory under the system temp dir, unique per test.
+std::filesystem::path temp_dir(const std::string& tag);
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+// Runs build/drape with the given argument string (shell-quoted by the caller).
+CommandResult run_drape(const std::string& args);
+
+}  // namespace drape::test

@@ -1,0 +1,28 @@
+#pragma once
+// Internal: one parser and one encoder per file format, all working on bytes in memory so that the
+// fuzz targets (fuzz/) exercise exactly what `drape info` runs. read_scene (scene_io.cpp) does the file
+// reading, format detection, validation and unit/axis conversion around them.
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "drape/io.hpp"
+
+namespace drape::io {
+
+// Each parser throws InputError(source, ...) on malformed input and fills the counts it alone knows
+// (faces triangulated, faces with fewer than three corners) into `check`.
+Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& check);
+Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source, MeshCheck& check);
+// `base_dir` is where external buffers of a .gltf are looked for (empty: external buffers are refused).
+Scene parse_gltf(std::span<const unsigned char> bytes, bool binary, const std::string& source,
+                 const std::string& base_dir, MeshCheck& check);
+
+// Checks one parsed mesh (non-empty, finite, indices in range, attribute sizes) and drops degenerate
+// triangles, counting them. `what` names the mesh in messages (e.g. "mesh 2 'shirt'").
+void validate_mesh(Mesh& mesh, const std::string& source, const std::string& what, MeshCheck& check);
+
+// Messages from libraries may span lines; the CLI contract is one line.
+std::string one_line(std::string_view message);
+
+}  // namespace drape::io

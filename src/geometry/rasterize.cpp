@@ -42,12 +42,13 @@ TriangleSetup setup_triangle(std::span<const ScreenVertex> vertices, const Tri& 
       return s;
   }
   for (int k = 0; k < 3; ++k) {
-    s.x[k] = std::llround(static_cast<double>(v[k].x) * kSubpixel);
-    s.y[k] = std::llround(static_cast<double>(v[k].y) * kSubpixel);
+    s.x[k] = static_cast<int32_t>(std::floor(static_cast<double>(v[k].x) * kSubpixel + 0.5));
+    s.y[k] = static_cast<int32_t>(std::floor(static_cast<double>(v[k].y) * kSubpixel + 0.5));
     s.z[k] = v[k].z;
     s.inv_w[k] = v[k].inv_w;
   }
   int64_t area = edge(s.x[0], s.y[0], s.x[1], s.y[1], s.x[2], s.y[2]);
+  static_assert(kSubpixelBits + 21 < 31, "fixed-point corners must fit in 32 bits");
   if (area == 0) return s;
   if (area < 0) {
     if (culling == FaceCulling::kBack) return s;
@@ -62,12 +63,13 @@ TriangleSetup setup_triangle(std::span<const ScreenVertex> vertices, const Tri& 
   // Edge k is the one opposite corner k: from corner k+1 to corner k+2.
   for (int k = 0; k < 3; ++k) {
     const int a = (k + 1) % 3, b = (k + 2) % 3;
-    s.bias[k] = edge_owns_samples(s.x[b] - s.x[a], s.y[b] - s.y[a]) ? 0 : -1;
+    s.bias[k] = edge_owns_samples(int64_t{s.x[b]} - s.x[a], int64_t{s.y[b]} - s.y[a]) ? 0 : -1;
   }
   // Pixels whose centre (i + 0.5) * kSubpixel lies within the fixed-point bounding box.
   const int64_t half = kSubpixel / 2;
   const int64_t min_x = std::min({s.x[0], s.x[1], s.x[2]}), max_x = std::max({s.x[0], s.x[1], s.x[2]});
   const int64_t min_y = std::min({s.y[0], s.y[1], s.y[2]}), max_y = std::max({s.y[0], s.y[1], s.y[2]});
+  // (min/max of int32 promoted to int64 for the pixel arithmetic below)
   const int64_t i0 = std::max<int64_t>(0, floor_div(min_x - half + kSubpixel - 1, kSubpixel));
   const int64_t i1 = std::min<int64_t>(width - 1, floor_div(max_x - half, kSubpixel));
   const int64_t j0 = std::max<int64_t>(0, floor_div(min_y - half + kSubpixel - 1, kSubpixel));
@@ -90,7 +92,7 @@ void draw_rows(const TriangleSetup& s, uint32_t triangle_index, int row_begin, i
   int64_t step_x[3];
   for (int k = 0; k < 3; ++k) {
     const int a = (k + 1) % 3, b = (k + 2) % 3;
-    step_x[k] = -(s.y[b] - s.y[a]) * kSubpixel;
+    step_x[k] = -(int64_t{s.y[b]} - s.y[a]) * kSubpixel;
   }
   const float dz1 = s.z[1] - s.z[0], dz2 = s.z[2] - s.z[0];
   for (int j = j_begin; j < j_end; ++j) {
@@ -144,7 +146,9 @@ void rasterize(std::span<const ScreenVertex> vertices, std::span<const Tri> tria
   // Set every triangle up once (independent work).
   const auto triangle_count = static_cast<int64_t>(triangles.size());
   out.setups.resize(triangles.size());
-#pragma omp parallel for schedule(static)
+  // Threads only pay off on real work: small jobs (a test quad, a text label) stay on one thread.
+  const bool parallel = triangle_count > 4096 || pixels > (size_t{1} << 18);
+#pragma omp parallel for schedule(static) if (parallel)
   for (int64_t t = 0; t < triangle_count; ++t)
     out.setups[static_cast<size_t>(t)] =
         setup_triangle(vertices, triangles[static_cast<size_t>(t)], width, height, options.culling);
@@ -170,7 +174,7 @@ void rasterize(std::span<const ScreenVertex> vertices, std::span<const Tri> tria
   }
 
   // Each band clears and draws its own rows: no two threads touch the same pixel.
-#pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
   for (int b = 0; b < bands; ++b) {
     const int row_begin = b * band_rows, row_end = std::min(height, row_begin + band_rows);
     const size_t first = static_cast<size_t>(row_begin) * static_cast<size_t>(width);
@@ -200,7 +204,7 @@ void render_depth_normal(std::span<const Vec3f> positions, std::span<const Tri> 
   std::vector<ScreenVertex> screen(positions.size());
   const float inv_pixel = 1.0f / pixel_size;
   const auto vertex_count = static_cast<int64_t>(positions.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (vertex_count > 8192)
   for (int64_t v = 0; v < vertex_count; ++v) {
     const Vec3f& p = positions[static_cast<size_t>(v)];
     screen[static_cast<size_t>(v)] = {(p.x() - origin.x()) * inv_pixel, (p.y() - origin.y()) * inv_pixel,
@@ -218,7 +222,7 @@ void render_depth_normal(std::span<const Vec3f> positions, std::span<const Tri> 
   out.normal.resize(pixels);
   out.triangle.resize(pixels);
   const auto pixel_count = static_cast<int64_t>(pixels);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (pixel_count > (int64_t{1} << 16))
   for (int64_t q = 0; q < pixel_count; ++q) {
     const auto p = static_cast<size_t>(q);
     out.triangle[p] = scratch.triangle[p];

@@ -45,11 +45,11 @@ inline constexpr uint32_t kNoTriangle = std::numeric_limits<uint32_t>::max();
 namespace raster_detail {
 // A triangle prepared for rasterization: fixed-point corners (1/256 pixel), counter-clockwise.
 struct TriangleSetup {
-  int64_t x[3], y[3];
-  int64_t bias[3];              // 0 for edges that own their samples (top-left rule), -1 otherwise
-  int i0, i1, j0, j1;           // covered pixel bounds, inclusive and clamped; j0 > j1 when culled
+  int32_t x[3], y[3];           // fixed-point corners (below 2^29 in magnitude)
+  int32_t i0, i1, j0, j1;       // covered pixel bounds, inclusive and clamped; j0 > j1 when culled
   float z[3], inv_w[3];
   float inv_area;               // 1 / (twice the fixed-point area)
+  int8_t bias[3];               // 0 for edges that own their samples (top-left rule), -1 otherwise
   bool swapped;                 // corners 1 and 2 were exchanged to make it counter-clockwise
 };
 }  // namespace raster_detail

@@ -15,6 +15,12 @@ std::filesystem::path shared_data() {
   return std::filesystem::exists(p) ? p : std::filesystem::path{};
 }
 
+std::filesystem::path shared_file(const std::string& rel) {
+  const std::filesystem::path root = shared_data();
+  if (root.empty() || !std::filesystem::exists(root / rel)) return {};
+  return root / rel;
+}
+
 std::filesystem::path temp_dir(const std::string& tag) {
   auto base = std::filesystem::temp_directory_path() /
               ("drape_test_" + tag + "_" + std::to_string(::getpid()));

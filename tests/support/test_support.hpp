@@ -8,14 +8,14 @@ namespace drape::test {
 
 // ../shared/data (absolute), or an empty path when it is absent (a user's fresh clone).
 std::filesystem::path shared_data();
-// Path of a file under ../shared/data; the calling test is skipped when it is missing.
+// Path of a file under ../shared/data, or an empty path when it (or ../shared/data) is missing.
+std::filesystem::path shared_file(const std::string& rel);
+// `auto p = DRAPE_REQUIRE_SHARED("bodies/...");` gives the path; the calling test is skipped with a
+// message when it is missing. (Use it only as the initialiser of a declaration, as shown.)
 #define DRAPE_REQUIRE_SHARED(rel)                                                              \
-  ([&]() {                                                                                     \
-    auto p = ::drape::test::shared_data() / (rel);                                             \
-    if (::drape::test::shared_data().empty() || !std::filesystem::exists(p))                   \
-      GTEST_SKIP() << "shared test data not found: " << p << " (needs ../shared/data)";        \
-    return p;                                                                                  \
-  }())
+  ::drape::test::shared_file(rel);                                                             \
+  if (::drape::test::shared_file(rel).empty())                                                 \
+  GTEST_SKIP() << "shared test data not found: " << (rel) << " (needs ../shared/data)"
 
 // A fresh empty directory under the system temp dir, unique per test.
 std::filesystem::path temp_dir(const std::string& tag);

@@ -13,5 +13,6 @@ void add_load_options(CLI::App& cmd, LoadOptions& opts);
 
 void add_info_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
+void add_render_command(CLI::App& app);  // cmd_render.cpp: pictures of mesh files
 
 }  // namespace drape::app

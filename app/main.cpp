@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
 
   drape::app::add_info_command(app);
   drape::app::add_convert_command(app);
+  drape::app::add_render_command(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,115 @@
+// Rasterizer and preview speed: the image-space collision maps (front + back depth/normal maps of a
+// body, paper sec. 4.2, redone every frame for an animated body) and a 3-view 1200x600 preview.
+// The scene is a 50k-triangle closed surface shaped like a standing body's bounding box, so the
+// benchmark runs without ../shared/data; with it, the MakeHuman body is measured too.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+#include "drape/io.hpp"
+#include "drape/render.hpp"
+#include "geometry/rasterize.hpp"
+
+namespace {
+
+using drape::Mesh;
+using drape::Vec3f;
+
+// An ellipsoid 0.45 x 1.75 x 0.3 m standing on the floor: about 50k triangles.
+Mesh standing_ellipsoid() {
+  const int slices = 224, stacks = 112;
+  const float pi = std::numbers::pi_v<float>;
+  Mesh m;
+  const Vec3f radii(0.225f, 0.875f, 0.15f), centre(0, 0.875f, 0);
+  m.positions.push_back(centre + Vec3f(0, radii.y(), 0));
+  for (int i = 1; i < stacks; ++i)
+    for (int j = 0; j < slices; ++j) {
+      const float theta = pi * static_cast<float>(i) / stacks, phi = 2 * pi * static_cast<float>(j) / slices;
+      m.positions.push_back(centre + Vec3f(std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi))
+                                         .cwiseProduct(radii));
+    }
+  m.positions.push_back(centre - Vec3f(0, radii.y(), 0));
+  const auto ring = [&](int i, int j) { return static_cast<uint32_t>(1 + (i - 1) * slices + (j % slices)); };
+  const auto bottom = static_cast<uint32_t>(m.positions.size() - 1);
+  for (int j = 0; j < slices; ++j) {
+    m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
+    for (int i = 1; i + 1 < stacks; ++i) {
+      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
+      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
+    }
+    m.triangles.push_back({ring(stacks - 1, j), bottom, ring(stacks - 1, j + 1)});
+  }
+  m.normals = drape::vertex_normals(m.positions, m.triangles);
+  return m;
+}
+
+Mesh shared_body() {
+  const auto path = std::filesystem::path(DRAPE_SHARED_DATA) / "bodies/makehuman/derived/mh_female_average.obj";
+  if (!std::filesystem::exists(path)) return {};
+  Mesh m = drape::read_mesh(path);
+  m.normals = drape::vertex_normals(m.positions, m.triangles);
+  return m;
+}
+
+void depth_normal_maps(benchmark::State& state, const Mesh& mesh) {
+  if (mesh.triangles.empty()) {
+    state.SkipWithError("../shared/data not found");
+    return;
+  }
+  const float pixel = static_cast<float>(state.range(0)) * 1e-3f;  // millimetres
+  drape::DepthNormalMap front, back;
+  drape::VisibilityBuffer scratch;
+  const drape::Bounds box = drape::bounds(mesh.positions);
+  const drape::Vec2f origin(box.min.x() - 0.01f, box.min.y() - 0.01f);
+  const int w = static_cast<int>(std::ceil((box.size().x() + 0.02f) / pixel));
+  const int h = static_cast<int>(std::ceil((box.size().y() + 0.02f) / pixel));
+  for (auto _ : state) {
+    drape::render_depth_normal(mesh.positions, mesh.triangles, mesh.normals, drape::ViewDirection::kFront, origin, pixel,
+                               w, h, front, scratch);
+    drape::render_depth_normal(mesh.positions, mesh.triangles, mesh.normals, drape::ViewDirection::kBack, origin, pixel,
+                               w, h, back, scratch);
+    benchmark::DoNotOptimize(front.depth.data());
+    benchmark::DoNotOptimize(back.depth.data());
+  }
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+  state.counters["pixels"] = static_cast<double>(w) * h;
+}
+
+void preview(benchmark::State& state, const Mesh& mesh) {
+  if (mesh.triangles.empty()) {
+    state.SkipWithError("../shared/data not found");
+    return;
+  }
+  drape::RenderOptions options;  // 1200 x 600, front/side/back, 3x3 supersampling, shadow, labels
+  options.title = "benchmark";
+  for (auto _ : state) benchmark::DoNotOptimize(drape::render_views({drape::body_item(mesh)}, options).rgb.data());
+  state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
+}
+
+void BM_DepthNormalMaps_Ellipsoid50k(benchmark::State& state) {
+  static const Mesh mesh = standing_ellipsoid();
+  depth_normal_maps(state, mesh);
+}
+void BM_DepthNormalMaps_Body(benchmark::State& state) {
+  static const Mesh mesh = shared_body();
+  depth_normal_maps(state, mesh);
+}
+void BM_Preview3Views_Ellipsoid50k(benchmark::State& state) {
+  static const Mesh mesh = standing_ellipsoid();
+  preview(state, mesh);
+}
+void BM_Preview3Views_Body(benchmark::State& state) {
+  static const Mesh mesh = shared_body();
+  preview(state, mesh);
+}
+
+}  // namespace
+
+// Pixel sizes 2 mm and 5 mm.
+BENCHMARK(BM_DepthNormalMaps_Ellipsoid50k)->Arg(2)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DepthNormalMaps_Body)->Arg(2)->Arg(5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Preview3Views_Ellipsoid50k)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Preview3Views_Body)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();

@@ -75,6 +75,10 @@ struct Legend {
   float lo = 0.0f, hi = 1.0f;
 };
 
+// A fit map: one scalar per vertex (strain, ease in metres, pressure) coloured through the
+// legend's map and range; pass the same legend in RenderOptions::legend to explain the colours.
+RenderItem scalar_item(const Mesh& mesh, std::span<const float> values, const Legend& legend);
+
 struct RenderOptions {
   int width = 1200, height = 600;  // the whole picture, panels side by side
   std::vector<ViewSpec> views{{"front", 0.0f}, {"side", 270.0f}, {"back", 180.0f}};

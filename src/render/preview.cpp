@@ -43,6 +43,16 @@ RenderItem garment_item(const Mesh& garment, size_t index) {
   return item;
 }
 
+RenderItem scalar_item(const Mesh& mesh, std::span<const float> values, const Legend& legend) {
+  if (values.size() != mesh.positions.size())
+    throw std::invalid_argument(fmt::format("render: fit map of '{}' has {} values for {} vertices", mesh.name,
+                                            values.size(), mesh.positions.size()));
+  RenderItem item;
+  item.mesh = &mesh;
+  item.vertex_colors = colorize(values, legend.map, legend.lo, legend.hi);
+  return item;
+}
+
 std::vector<ViewSpec> parse_views(std::string_view comma_separated, const std::string& source) {
   std::vector<ViewSpec> views;
   size_t start = 0;
@@ -256,7 +266,7 @@ Image render_views(const std::vector<RenderItem>& items, const RenderOptions& op
     for (int k = 0; k <= 4; ++k)
       legend_ticks.push_back(fmt::format("{:.3g}", options.legend->lo + (options.legend->hi - options.legend->lo) * static_cast<float>(k) / 4));
     int widest = text_width(options.legend->title, text_scale);
-    for (const auto& t : legend_ticks) widest = std::max(widest, 14 * text_scale + text_width(t, text_scale));
+    for (const auto& t : legend_ticks) widest = std::max(widest, 15 * text_scale + text_width(t, text_scale));
     legend_w = widest + 12 * text_scale;
   }
   const int panel_count = static_cast<int>(options.views.size());
@@ -373,7 +383,7 @@ Image render_views(const std::vector<RenderItem>& items, const RenderOptions& op
         uint8_t* px = image.pixel(x, std::clamp(y, 0, options.height - 1));
         px[0] = px[1] = px[2] = to_byte(0.05f);
       }
-      draw_text(image, bar_x + bar_w + 5 * text_scale, y - 4 * text_scale, legend_ticks[k], ink, text_scale);
+      draw_text(image, bar_x + bar_w + 6 * text_scale, y - 4 * text_scale, legend_ticks[k], ink, text_scale);
     }
   }
   return image;

@@ -111,6 +111,10 @@ TEST(Render, PerVertexColoursAndLegend) {
   EXPECT_NO_THROW(render_views({item}, o));
   o.legend = Legend{"nan", ColorMap::kViridis, std::nanf(""), 2.0f};
   EXPECT_NO_THROW(render_views({item}, o));
+  // A fit map must have one value per vertex.
+  const std::vector<float> too_few(3, 0.0f);
+  EXPECT_THROW(scalar_item(sphere, too_few, *o.legend), std::invalid_argument);
+  EXPECT_EQ(scalar_item(sphere, height, *o.legend).vertex_colors.size(), sphere.positions.size());
   o.width = 40;  // the legend leaves no room for the view
   EXPECT_THROW(render_views({item}, o), std::invalid_argument);
 }

@@ -24,5 +24,9 @@ void validate_mesh(Mesh& mesh, const std::string& source, const std::string& wha
 
 // Messages from libraries may span lines; the CLI contract is one line.
 std::string one_line(std::string_view message);
+// A token from a file, quoted into a message: non-printable bytes become '?', long ones are cut.
+std::string printable(std::string_view token);
+// "mesh 3" or "mesh 3 'shirt'": how messages name an indexed, optionally named glTF object.
+std::string element_name(const char* kind, size_t index, const std::string& name);
 
 }  // namespace drape::io

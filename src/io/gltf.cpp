@@ -15,7 +15,9 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fmt/format.h>
+#include <fstream>
 #include <sstream>
 
 #include "drape/error.hpp"
@@ -27,6 +29,39 @@ namespace {
 // Images are not needed (drape renders its own materials): accept them undecoded.
 bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
   return true;
+}
+
+// External buffers: only regular files are read (never a device or a pipe, which could hang), and
+// nothing is ever written.
+bool regular_file_exists(const std::string& path, void*) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+std::string keep_path(const std::string& path, void*) { return path; }
+bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    if (err) *err += "external buffer '" + path + "' is not a readable file";
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? static_cast<std::streamoff>(in.tellg()) : -1;
+  if (size < 0) {
+    if (err) *err += "cannot read external buffer '" + path + "'";
+    return false;
+  }
+  out->resize(static_cast<size_t>(size));
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(out->data()), size);
+  if (!in) {
+    if (err) *err += "cannot read external buffer '" + path + "'";
+    return false;
+  }
+  return true;
+}
+bool refuse_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not allowed while reading";
+  return false;
 }
 
 // A validated, strided view of one accessor's elements.
@@ -192,13 +227,13 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
   };
   const bool normals = every("NORMAL"), uvs = every("TEXCOORD_0"), colors = every("COLOR_0");
   const bool skinned = every("JOINTS_0") && every("WEIGHTS_0");
-  if (gm.primitives.empty()) fail(fmt::format("mesh {} '{}' has no primitives", index, gm.name));
+  if (gm.primitives.empty()) fail(element_name("mesh", index, gm.name) + " has no primitives");
   const size_t target_count = gm.primitives[0].targets.size();
   mesh.morph_targets.resize(target_count);
 
   for (size_t pi = 0; pi < gm.primitives.size(); ++pi) {
     const tinygltf::Primitive& prim = gm.primitives[pi];
-    const std::string what = fmt::format("mesh {} '{}' primitive {}", index, gm.name, pi);
+    const std::string what = fmt::format("{} primitive {}", element_name("mesh", index, gm.name), pi);
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
       fail(fmt::format("{}: mode {} is not triangles (points and lines are not meshes)", what, mode));
@@ -304,7 +339,8 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
       if (names.Get(static_cast<int>(t)).IsString()) mesh.morph_targets[t].name = names.Get(static_cast<int>(t)).Get<std::string>();
   }
   if (!gm.weights.empty() && gm.weights.size() != target_count)
-    fail(fmt::format("mesh {} '{}' has {} default weights for {} morph targets", index, gm.name, gm.weights.size(), target_count));
+    fail(fmt::format("{} has {} default weights for {} morph targets", element_name("mesh", index, gm.name),
+                     gm.weights.size(), target_count));
   mesh.morph_weights.assign(target_count, 0.0f);
   for (size_t t = 0; t < gm.weights.size(); ++t) mesh.morph_weights[t] = static_cast<float>(gm.weights[t]);
   if (target_count == 0) mesh.morph_weights.clear();
@@ -319,7 +355,7 @@ void GltfReader::read_nodes(Scene& scene) const {
   for (size_t i = 0; i < count; ++i) {
     const tinygltf::Node& gn = model_.nodes[i];
     Node& node = scene.nodes[i];
-    const std::string what = fmt::format("node {} '{}'", i, gn.name);
+    const std::string what = element_name("node", i, gn.name);
     node.name = gn.name;
     if (gn.mesh >= 0 && static_cast<size_t>(gn.mesh) >= model_.meshes.size()) fail(fmt::format("{}: mesh {} does not exist", what, gn.mesh));
     if (gn.skin >= 0 && static_cast<size_t>(gn.skin) >= model_.skins.size()) fail(fmt::format("{}: skin {} does not exist", what, gn.skin));
@@ -379,7 +415,7 @@ void GltfReader::read_nodes(Scene& scene) const {
 void GltfReader::read_skins(Scene& scene) const {
   for (size_t s = 0; s < model_.skins.size(); ++s) {
     const tinygltf::Skin& gs = model_.skins[s];
-    const std::string what = fmt::format("skin {} '{}'", s, gs.name);
+    const std::string what = element_name("skin", s, gs.name);
     Skin skin;
     skin.name = gs.name;
     if (gs.joints.empty()) fail(what + " has no joints");
@@ -412,7 +448,8 @@ void GltfReader::read_skins(Scene& scene) const {
     for (size_t v = 0; v < mesh.joints.size(); ++v)
       for (int k = 0; k < 4; ++k)
         if (mesh.joints[v][static_cast<size_t>(k)] >= joints && mesh.weights[v][k] != 0.0f)
-          fail(fmt::format("mesh {} '{}': vertex {} uses joint {} but skin {} has {} joints", node.mesh, mesh.name, v,
+          fail(fmt::format("{}: vertex {} uses joint {} but skin {} has {} joints",
+                           element_name("mesh", static_cast<size_t>(node.mesh), mesh.name), v,
                            mesh.joints[v][static_cast<size_t>(k)], node.skin, joints));
   }
 }
@@ -424,7 +461,7 @@ void GltfReader::read_animations(Scene& scene) const {
     animation.name = ga.name;
     for (size_t c = 0; c < ga.channels.size(); ++c) {
       const tinygltf::AnimationChannel& gc = ga.channels[c];
-      const std::string what = fmt::format("animation {} '{}' channel {}", a, ga.name, c);
+      const std::string what = fmt::format("{} channel {}", element_name("animation", a, ga.name), c);
       if (gc.target_node < 0) continue;  // allowed by the spec (an extension may target something else)
       if (static_cast<size_t>(gc.target_node) >= scene.nodes.size()) fail(fmt::format("{}: node {} does not exist", what, gc.target_node));
       if (gc.sampler < 0 || static_cast<size_t>(gc.sampler) >= ga.samplers.size()) fail(fmt::format("{}: sampler {} does not exist", what, gc.sampler));
@@ -443,11 +480,11 @@ void GltfReader::read_animations(Scene& scene) const {
         if (mesh < 0) fail(what + ": animates morph weights of a node without a mesh");
         width = scene.meshes[static_cast<size_t>(mesh)].morph_targets.size();
         if (width == 0) fail(what + ": animates morph weights of a mesh without morph targets");
-      } else fail(fmt::format("{}: unknown path '{}'", what, gc.target_path));
+      } else fail(fmt::format("{}: unknown path '{}'", what, printable(gc.target_path)));
       if (gs.interpolation == "LINEAR") channel.interpolation = Interpolation::Linear;
       else if (gs.interpolation == "STEP") channel.interpolation = Interpolation::Step;
       else if (gs.interpolation == "CUBICSPLINE") channel.interpolation = Interpolation::CubicSpline;
-      else fail(fmt::format("{}: unknown interpolation '{}'", what, gs.interpolation));
+      else fail(fmt::format("{}: unknown interpolation '{}'", what, printable(gs.interpolation)));
       const AccessorView in = view(gs.input, what + " input", {TINYGLTF_TYPE_SCALAR}, {kFloat});
       const AccessorView out = view(gs.output, what + " output", {type},
                                     channel.path == AnimationPath::Rotation ? std::initializer_list<int>{kFloat, kByte, kShort, kUByte, kUShort}
@@ -485,8 +522,23 @@ Scene parse_gltf(std::span<const unsigned char> bytes, bool binary, const std::s
   if (binary && (bytes.size() < 4 || std::memcmp(bytes.data(), "glTF", 4) != 0))
     throw InputError(source, "not a GLB file (bad magic)");
   if (bytes.size() > 0xffffffffu) throw InputError(source, "file larger than 4 GiB");
+  if (binary) {
+    // The GLB container (header, then chunks of declared length), so a cut file says so.
+    const auto u32 = [&](size_t at) {
+      uint32_t v = 0;
+      std::memcpy(&v, bytes.data() + at, 4);
+      return v;
+    };
+    if (bytes.size() < 20) throw InputError(source, fmt::format("truncated GLB: {} bytes, not even a header", bytes.size()));
+    if (u32(4) != 2) throw InputError(source, fmt::format("GLB container version {} is not supported (drape reads 2)", u32(4)));
+    if (u32(8) != bytes.size())
+      throw InputError(source, fmt::format("GLB header says {} bytes but the file has {} (truncated?)", u32(8), bytes.size()));
+    if (u32(16) != 0x4E4F534Au) throw InputError(source, "GLB does not start with a JSON chunk");
+    if (u32(12) > bytes.size() - 20) throw InputError(source, "GLB JSON chunk runs past the end of the file");
+  }
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
+  loader.SetFsCallbacks({regular_file_exists, keep_path, read_regular_file, refuse_write, nullptr});
   tinygltf::Model model;
   std::string err, warn;
   const auto size = static_cast<unsigned int>(bytes.size());
@@ -494,6 +546,8 @@ Scene parse_gltf(std::span<const unsigned char> bytes, bool binary, const std::s
                          : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
                                                       size, base_dir);
   if (!ok) throw InputError(source, one_line(err.empty() ? "not a valid glTF file" : err));
+  if (model.asset.version.rfind("2.", 0) != 0)
+    throw InputError(source, fmt::format("glTF version '{}' is not supported (drape reads 2.0)", printable(model.asset.version)));
   return GltfReader(model, source).read(check);
 }
 

@@ -80,8 +80,8 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
                        most > least ? fmt::format(" to {}", most) : std::string()));
     for (size_t i = 1; i < tok.size(); ++i) {
       double x = 0;
-      if (!parse_number(tok[i], x)) fail(fmt::format("{}: '{}' is not a number", what, tok[i]));
-      if (!std::isfinite(x)) fail(fmt::format("{} has a non-finite value '{}'", what, tok[i]));
+      if (!parse_number(tok[i], x)) fail(fmt::format("{}: '{}' is not a number", what, printable(tok[i])));
+      if (!std::isfinite(x)) fail(fmt::format("{} has a non-finite value '{}'", what, printable(tok[i])));
     }
     return n;
   };
@@ -91,7 +91,7 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
     size_t part = 0, start = 0;
     for (size_t i = 0; i <= corner.size(); ++i)
       if (i == corner.size() || corner[i] == '/') {
-        if (part >= 3) fail(fmt::format("face corner '{}' has more than three indices", corner));
+        if (part >= 3) fail(fmt::format("face corner '{}' has more than three indices", printable(corner)));
         parts[part++] = corner.substr(start, i - start);
         start = i + 1;
       }
@@ -101,10 +101,10 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
     for (size_t k = 0; k < part; ++k) {
       if (parts[k].empty() && k > 0) continue;  // v//n
       long index = 0;
-      if (!parse_index(parts[k], index)) fail(fmt::format("face corner '{}' has a bad {} index", corner, names[k]));
+      if (!parse_index(parts[k], index)) fail(fmt::format("face corner '{}' has a bad {} index", printable(corner), names[k]));
       if (index < 0) {
         if (static_cast<size_t>(-index) > counts[k])
-          fail(fmt::format("face corner '{}': relative {} index {} points before the first one", corner,
+          fail(fmt::format("face corner '{}': relative {} index {} points before the first one", printable(corner),
                            names[k], index));
       } else if (index > maxima[k]->index) {
         *maxima[k] = {index, line_number};

@@ -106,7 +106,7 @@ Header parse_header(std::string_view data, const std::string& source) {
       if (w[1] == "ascii") header.encoding = Encoding::Ascii;
       else if (w[1] == "binary_little_endian") header.encoding = Encoding::Little;
       else if (w[1] == "binary_big_endian") header.encoding = Encoding::Big;
-      else fail(line_number, fmt::format("unknown encoding '{}'", w[1]));
+      else fail(line_number, fmt::format("unknown encoding '{}'", printable(w[1])));
       have_format = true;
     } else if (w[0] == "element") {
       size_t count = 0;
@@ -120,24 +120,24 @@ Header parse_header(std::string_view data, const std::string& source) {
       if (w.size() == 5 && w[1] == "list") {
         const auto count_type = type_named(w[2]), item_type = type_named(w[3]);
         if (!count_type || !item_type || !is_integer(*count_type))
-          fail(line_number, fmt::format("bad list types '{} {}'", w[2], w[3]));
+          fail(line_number, fmt::format("bad list types '{} {}'", printable(w[2]), printable(w[3])));
         p = {std::string(w[4]), *item_type, true, *count_type};
       } else if (w.size() == 3) {
         const auto type = type_named(w[1]);
-        if (!type) fail(line_number, fmt::format("unknown property type '{}'", w[1]));
+        if (!type) fail(line_number, fmt::format("unknown property type '{}'", printable(w[1])));
         p = {std::string(w[2]), *type, false, Type::UInt8};
       } else {
         fail(line_number, "expected 'property <type> <name>' or 'property list <count type> <type> <name>'");
       }
       header.elements.back().properties.push_back(p);
     } else {
-      fail(line_number, fmt::format("unknown keyword '{}'", w[0]));
+      fail(line_number, fmt::format("unknown keyword '{}'", printable(w[0])));
     }
   }
   if (!have_format) throw InputError(source, "PLY header has no 'format' line");
   for (const Element& e : header.elements)
     if (e.count > 0 && e.properties.empty())
-      throw InputError(source, fmt::format("PLY element '{}' has no properties", e.name));
+      throw InputError(source, fmt::format("PLY element '{}' has no properties", printable(e.name)));
   header.body_offset = pos;
   return header;
 }
@@ -192,9 +192,9 @@ class BodyReader {
     double v = 0;
     const auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
     if (ec != std::errc() || ptr != token.data() + token.size())
-      throw InputError(source_, fmt::format("{}: '{}' is not a number", what, token));
+      throw InputError(source_, fmt::format("{}: '{}' is not a number", what, printable(token)));
     if (is_integer(type) && v != std::floor(v))
-      throw InputError(source_, fmt::format("{}: '{}' is not an integer", what, token));
+      throw InputError(source_, fmt::format("{}: '{}' is not an integer", what, printable(token)));
     return v;
   }
 
@@ -226,7 +226,7 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
     // Each element takes at least one byte per property: a larger count cannot be in the file.
     if (e.count > reader.remaining() / e.properties.size())
       throw InputError(source, fmt::format("truncated PLY data: header promises {} '{}' elements, the file is too "
-                                           "short for them", e.count, e.name));
+                                           "short for them", e.count, printable(e.name)));
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;
     // Columns of interest; -1 when absent.
@@ -258,7 +258,7 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
 
     std::vector<double> row(e.properties.size());
     for (size_t i = 0; i < e.count; ++i) {
-      const std::string what = fmt::format("{} {}", e.name, i);
+      const std::string what = fmt::format("{} {}", printable(e.name), i);
       for (size_t k = 0; k < e.properties.size(); ++k) {
         const Property& p = e.properties[k];
         if (!p.is_list) {

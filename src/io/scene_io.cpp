@@ -87,7 +87,7 @@ Scene parse_scene(std::span<const unsigned char> bytes, MeshFormat format, const
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const std::string what = scene.meshes.size() == 1 && (format == MeshFormat::Obj || format == MeshFormat::Ply)
                                  ? std::string("mesh")
-                                 : fmt::format("mesh {} '{}'", m, scene.meshes[m].name);
+                                 : io::element_name("mesh", m, scene.meshes[m].name);
     io::validate_mesh(scene.meshes[m], source, what, check);
   }
   if (options.metres_per_unit != 1.0 || options.up != UpAxis::Y) {

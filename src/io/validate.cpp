@@ -12,12 +12,28 @@ std::string one_line(std::string_view message) {
   for (char c : message) {
     if (c == '\n' || c == '\r') {
       if (!out.empty() && out.back() != ' ') out += "; ";
-    } else if (static_cast<unsigned char>(c) >= 0x20) {
-      out += c;
+    } else {
+      const auto u = static_cast<unsigned char>(c);
+      if (u >= 0x20) out += u < 0x7f ? c : '?';
     }
   }
   while (!out.empty() && (out.back() == ' ' || out.back() == ';' || out.back() == '.')) out.pop_back();
   return out.empty() ? std::string("unknown error") : out;
+}
+
+std::string printable(std::string_view token) {
+  constexpr size_t kMax = 40;
+  std::string out;
+  for (char c : token.substr(0, kMax)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += u >= 0x20 && u < 0x7f ? c : '?';
+  }
+  if (token.size() > kMax) out += "...";
+  return out;
+}
+
+std::string element_name(const char* kind, size_t index, const std::string& name) {
+  return name.empty() ? fmt::format("{} {}", kind, index) : fmt::format("{} {} '{}'", kind, index, printable(name));
 }
 
 namespace {

@@ -23,12 +23,14 @@ Image::Image(int w, int h, const Vec3f& fill_linear) : width(w), height(h) {
 }
 
 float srgb_to_linear(float c) {
-  c = std::clamp(c, 0.0f, 1.0f);
+  if (!(c > 0.0f)) return 0.0f;  // also NaN
+  c = std::min(c, 1.0f);
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
 float linear_to_srgb(float c) {
-  c = std::clamp(c, 0.0f, 1.0f);
+  if (!(c > 0.0f)) return 0.0f;  // also NaN
+  c = std::min(c, 1.0f);
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
 }
 
@@ -99,16 +101,25 @@ void blend(uint8_t* px, const Vec3f& srgb, float coverage) {
     px[c] = static_cast<uint8_t>(std::lround(std::clamp(value, 0.0f, 255.0f)));
   }
 }
+
+// stb_easy_font indexes a table by character without checking: keep to printable ASCII.
+std::string printable_ascii(std::string_view text) {
+  std::string out(text);
+  for (char& c : out)
+    if (c != '\n' && (c < 32 || c > 126)) c = '?';
+  return out;
+}
+
 }  // namespace
 
 int text_width(std::string_view text, int scale) {
-  std::string buffer(text);
+  std::string buffer = printable_ascii(text);
   return stb_easy_font_width(buffer.data()) * std::max(1, scale);
 }
 
 int draw_text(Image& image, int x, int y, std::string_view text, const Vec3f& color_linear, int scale) {
   scale = std::max(1, scale);
-  std::string buffer(text);
+  std::string buffer = printable_ascii(text);
   // stb_easy_font emits at most about 270 bytes of quads per character.
   std::vector<EasyFontVertex> quads(buffer.size() * 80 + 64);
   unsigned char white[4] = {255, 255, 255, 255};

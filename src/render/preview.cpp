@@ -243,7 +243,7 @@ uint8_t to_byte(float linear) {
       t[static_cast<size_t>(k)] = static_cast<uint8_t>(std::lround(255.0f * linear_to_srgb(static_cast<float>(k) / kSteps)));
     return t;
   }();
-  const float x = std::clamp(linear, 0.0f, 1.0f) * kSteps;
+  const float x = linear > 0.0f ? std::min(linear, 1.0f) * kSteps : 0.0f;  // NaN -> 0
   return table[static_cast<size_t>(x + 0.5f)];
 }
 

@@ -82,7 +82,7 @@ RenderItem scalar_item(const Mesh& mesh, std::span<const float> values, const Le
 struct RenderOptions {
   int width = 1200, height = 600;  // the whole picture, panels side by side
   std::vector<ViewSpec> views{{"front", 0.0f}, {"side", 270.0f}, {"back", 180.0f}};
-  int supersample = 3;             // samples per pixel along each axis (anti-aliasing)
+  int supersample = 3;             // samples per pixel along each axis (anti-aliasing); lowered for huge pictures
   float elevation_degrees = 6.0f;  // camera looks slightly down, so the floor shows
   // Scale in picture pixels per metre; 0 fits the scene. Fix it to compare pictures of different
   // scenes (frames of an animation, two simulation methods) at the same size.

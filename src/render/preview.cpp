@@ -253,6 +253,8 @@ Image render_views(const std::vector<RenderItem>& items, const RenderOptions& op
   if (options.views.empty()) throw std::invalid_argument("render: no views");
   if (options.width < 32 || options.height < 32 || options.width > 16384 || options.height > 16384)
     throw std::invalid_argument("render: picture size must be between 32 and 16384 pixels");
+  if (static_cast<int64_t>(options.width) * options.height > (int64_t{1} << 26))
+    throw std::invalid_argument("render: picture larger than 64 megapixels");
   if (options.supersample < 1 || options.supersample > 8) throw std::invalid_argument("render: supersample must be 1..8");
   const Scene scene = gather(items);
 
@@ -302,7 +304,11 @@ Image render_views(const std::vector<RenderItem>& items, const RenderOptions& op
     }
   }
 
-  const int ss = options.supersample;
+  // Supersampling is lowered for very large pictures so a panel's sample buffers stay under
+  // about half a gigabyte (2^25 samples of 16 bytes).
+  constexpr double kMaxSamples = double(1 << 25);
+  const double panel_pixels = static_cast<double>(panel_w) * static_cast<double>(panel_h);
+  const int ss = std::max(1, std::min(options.supersample, static_cast<int>(std::sqrt(kMaxSamples / panel_pixels))));
   const int sw = panel_w * ss, sh = panel_h * ss;
   std::vector<ScreenVertex> screen(scene.positions.size());
   for (size_t k = 0; k < cameras.size(); ++k) {

@@ -12,8 +12,7 @@
 namespace drape::app {
 namespace {
 
-constexpr double kQuietSeconds = 1.0;       // runs shorter than this print nothing
-constexpr double kRedrawSeconds = 0.1;      // at most 10 updates a second
+constexpr double kRedrawSeconds = 0.1;  // at most 10 updates a second
 
 std::string clock_text(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "--:--";
@@ -32,8 +31,12 @@ int terminal_columns(std::FILE* out) {
 Progress::Progress(std::string task, double total)
     : Progress(std::move(task), total, stderr, isatty(fileno(stderr)) != 0) {}
 
-Progress::Progress(std::string task, double total, std::FILE* out, bool is_terminal)
-    : task_(std::move(task)), total_(total > 0 ? total : 0), out_(out), enabled_(is_terminal && out != nullptr) {}
+Progress::Progress(std::string task, double total, std::FILE* out, bool is_terminal, double quiet_seconds)
+    : task_(std::move(task)),
+      total_(total > 0 ? total : 0),
+      out_(out),
+      enabled_(is_terminal && out != nullptr),
+      quiet_seconds_(quiet_seconds) {}
 
 Progress::~Progress() { finish(); }
 
@@ -41,7 +44,7 @@ void Progress::update(double done, std::string_view detail) {
   if (!enabled_) return;
   const Clock::time_point now = Clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  if (elapsed < kQuietSeconds || std::chrono::duration<double>(now - last_draw_).count() < kRedrawSeconds) return;
+  if (elapsed < quiet_seconds_ || std::chrono::duration<double>(now - last_draw_).count() < kRedrawSeconds) return;
   last_draw_ = now;
   draw(done, detail, elapsed);
 }
@@ -63,14 +66,17 @@ void Progress::draw(double done, std::string_view detail, double elapsed_s) {
   // Fit the terminal so the line never wraps (a wrapped line cannot be redrawn with \r).
   const auto columns = static_cast<size_t>(terminal_columns(out_) - 1);
   if (line.size() > columns) line.resize(columns);
-  fmt::print(out_, "\r{}\x1b[K", line);
+  // stdio, not fmt::print: a terminal that went away must not throw (finish() runs in a destructor).
+  std::fputc('\r', out_);
+  std::fputs(line.c_str(), out_);
+  std::fputs("\x1b[K", out_);
   std::fflush(out_);
   shown_ = true;
 }
 
 void Progress::finish() {
   if (!shown_) return;
-  fmt::print(out_, "\r\x1b[K");
+  std::fputs("\r\x1b[K", out_);
   std::fflush(out_);
   shown_ = false;
 }

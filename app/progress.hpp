@@ -23,8 +23,9 @@ class Progress {
  public:
   // `total` units of work (iterations, frames); 0 when unknown (no bar, no estimate).
   Progress(std::string task, double total);
-  // For tests and special cases: write to `out` and decide yourself whether it is a terminal.
-  Progress(std::string task, double total, std::FILE* out, bool is_terminal);
+  // For tests and special cases: write to `out`, decide yourself whether it is a terminal, and
+  // after how many seconds the line may first appear.
+  Progress(std::string task, double total, std::FILE* out, bool is_terminal, double quiet_seconds = 1.0);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -44,6 +45,7 @@ class Progress {
   double total_;
   std::FILE* out_;
   bool enabled_;
+  double quiet_seconds_;
   bool shown_ = false;
   Clock::time_point start_ = Clock::now();
   Clock::time_point last_draw_{};

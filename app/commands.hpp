@@ -14,5 +14,6 @@ void add_load_options(CLI::App& cmd, LoadOptions& opts);
 void add_info_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_render_command(CLI::App& app);  // cmd_render.cpp: pictures of mesh files
+void add_scene_command(CLI::App& app);  // cmd_scene.cpp: paper fig. 7 draping scenes
 
 }  // namespace drape::app

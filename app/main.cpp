@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   drape::app::add_info_command(app);
   drape::app::add_convert_command(app);
   drape::app::add_render_command(app);
+  drape::app::add_scene_command(app);
 
   try {
     app.parse(argc, argv);

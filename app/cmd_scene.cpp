@@ -1,0 +1,223 @@
+// `drape scene sphere|table`: Vassilev & Spanlang fig. 7. Drops a square cloth over a sphere or a
+// table, runs until it settles and writes DIR/report.json (DESIGN.md's quality and simulation
+// keys), DIR/scene.glb and DIR/preview.png. Exit 3 when a gate failed (NaN, explosion, not settled).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "commands.hpp"
+#include "drape/cloth_scene.hpp"
+#include "drape/error.hpp"
+#include "drape/files.hpp"
+#include "drape/io.hpp"
+#include "drape/render.hpp"
+
+namespace drape::app {
+namespace {
+
+struct SceneArgs {
+  std::string obstacle = "sphere";
+  uint32_t n = 64;
+  std::string strain_limit = "velocity";
+  float threshold = -1;
+  int passes = 4;
+  std::string fabric = "cotton";
+  float time_step = 0;
+  double max_time = 12;
+  std::string out = "out";
+  bool compare = true;
+};
+
+// One finished run of the scene, for the report and the picture.
+struct Finished {
+  ClothScene scene;
+  SceneRun run;
+  SceneQuality quality;
+  std::string label;
+};
+
+Finished simulate(const ClothSceneOptions& o, double max_time, const std::string& label) {
+  Finished f{make_cloth_scene(o), {}, {}, label};
+  const float dt = f.scene.settings.time_step > 0 ? f.scene.settings.time_step : f.scene.model.stable_time_step();
+  std::fprintf(stderr, "scene %s: %u x %u cloth (%s), %s, dt %.3g s\n", std::string(to_string(o.obstacle)).c_str(), o.n,
+               o.n, o.fabric.name.c_str(), label.c_str(), dt);
+  SettleCriteria settle;
+  settle.max_time = max_time;
+  f.run = run_until_settled(f.scene, settle, [](const ClothState& s) {
+    std::fprintf(stderr, "  t = %5.2f s  iterations %8llu  max speed %.3f m/s\n", s.time,
+                 static_cast<unsigned long long>(s.iterations), s.max_speed);
+  });
+  f.quality = scene_quality(f.scene);
+  std::fprintf(stderr, "  %s after %llu iterations (%.2f s simulated, %.2f s wall): max strain %.4f, p99 %.4f, %zu inside\n",
+               f.run.status != StepStatus::Ok ? "FAILED" : f.run.settled ? "settled" : "NOT settled",
+               static_cast<unsigned long long>(f.run.iterations), f.scene.state.time, f.run.wall_seconds,
+               f.quality.strain.max, f.quality.strain.p99, f.quality.penetrating_vertices);
+  return f;
+}
+
+std::string limit_label(StrainLimit limit, float threshold) {
+  if (limit == StrainLimit::None) return "no strain limit";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%s modification at %.3g %%", limit == StrainLimit::Velocity ? "velocity" : "position",
+                100.0 * threshold);
+  return buf;
+}
+
+// The cloth coloured by structural strain (white unstretched, red stretched), over the obstacle.
+Image picture(const Finished& f, float strain_range) {
+  const Mesh cloth = cloth_mesh(f.scene.model, f.scene.state);
+  const Mesh body = f.scene.obstacle_mesh();
+  RenderItem cloth_item = garment_item(cloth, 0);
+  const std::vector<float> strain = particle_strain(f.scene.model, f.scene.state.x);
+  cloth_item.vertex_colors = colorize(strain, ColorMap::kBlueWhiteRed, -strain_range, strain_range);
+  RenderOptions options;
+  options.width = 960;
+  options.height = 480;
+  options.views = {{"front", 0.0f}, {"three-quarter", 45.0f}};
+  options.elevation_degrees = 25.0f;
+  options.pixels_per_metre = 330.0f;
+  char title[160];
+  std::snprintf(title, sizeof title, "%s: max strain %.1f %%, p99 %.1f %%", f.label.c_str(), 100.0 * f.quality.strain.max,
+                100.0 * f.quality.strain.p99);
+  options.title = title;
+  options.legend = Legend{"structural strain", ColorMap::kBlueWhiteRed, -strain_range, strain_range};
+  return render_views({body_item(body), cloth_item}, options);
+}
+
+nlohmann::json strain_json(const StrainStats& s) {
+  return {{"max", s.max}, {"p99", s.p99}, {"mean_abs", s.mean_abs}, {"min", s.min}, {"global", s.global}};
+}
+
+void run_scene(const SceneArgs& a) {
+  ClothSceneOptions o;
+  if (a.obstacle != "sphere" && a.obstacle != "table")
+    throw InputError("scene", "unknown obstacle '" + a.obstacle + "' (sphere or table)");
+  o.obstacle = a.obstacle == "sphere" ? SceneObstacle::Sphere : SceneObstacle::Table;
+  o.n = a.n;
+  o.fabric = fabric_or_throw(a.fabric);
+  static const std::map<std::string, StrainLimit> limits = {
+      {"none", StrainLimit::None}, {"position", StrainLimit::Position}, {"velocity", StrainLimit::Velocity}};
+  const auto limit = limits.find(a.strain_limit);
+  if (limit == limits.end()) throw InputError("--strain-limit", "'" + a.strain_limit + "' is not none, position or velocity");
+  o.strain_limit = limit->second;
+  o.strain_threshold = a.threshold;
+  o.strain_passes = a.passes;
+  if (!(a.time_step >= 0 && a.time_step < 0.1f)) throw InputError("--dt", "the time step must be in [0, 0.1) s");
+  o.time_step = a.time_step;
+  if (!(a.max_time > 0 && a.max_time <= 600)) throw InputError("--max-time", "must be in (0, 600] s");
+  const float threshold = a.threshold >= 0 ? a.threshold : o.fabric.strain_threshold;
+
+  Finished main_run = simulate(o, a.max_time, limit_label(o.strain_limit, threshold));
+  // The paper's point in one picture: the same cloth without a limit, or with velocity modification.
+  std::optional<Finished> other;
+  if (a.compare) {
+    ClothSceneOptions c = o;
+    c.strain_limit = o.strain_limit == StrainLimit::None ? StrainLimit::Velocity : StrainLimit::None;
+    other = simulate(c, a.max_time, limit_label(c.strain_limit, threshold));
+  }
+  const ClothScene& scene = main_run.scene;
+  const SceneRun& run = main_run.run;
+  const SceneQuality& q = main_run.quality;
+  const float dt = scene.settings.time_step > 0 ? scene.settings.time_step : scene.model.stable_time_step();
+
+  // report.json: DESIGN.md's quality and simulation keys, then what this scene adds.
+  nlohmann::json report;
+  report["quality"] = {{"max_strain", q.strain.max},
+                       {"p99_strain", q.strain.p99},
+                       {"penetrating_vertices", q.penetrating_vertices},
+                       {"penetration_fraction", q.penetration_fraction},
+                       {"max_penetration_m", q.max_penetration},
+                       {"max_seam_gap_m", 0.0},
+                       {"mean_seam_gap_m", 0.0},
+                       {"settled", run.settled}};
+  const auto per_iteration = [&](double total) { return run.iterations ? total / static_cast<double>(run.iterations) : 0.0; };
+  report["simulation"] = {{"iterations", run.iterations},
+                          {"time_step_s", dt},
+                          {"wall_seconds", run.wall_seconds},
+                          {"seconds_per_iteration", per_iteration(run.wall_seconds)},
+                          {"simulated_seconds", scene.state.time},
+                          {"settled_at_s", run.settled ? nlohmann::json(run.settled_at) : nlohmann::json(nullptr)},
+                          {"status", std::string(to_string(run.status))},
+                          {"vertices", scene.model.particle_count()},
+                          {"springs", scene.model.spring_count()},
+                          {"strain_passes_per_iteration", per_iteration(static_cast<double>(run.profile.strain_passes))},
+                          {"iterations_at_pass_limit", run.profile.steps_at_pass_limit},
+                          {"contacts_per_iteration", per_iteration(static_cast<double>(run.profile.contacts))}};
+  nlohmann::json stages;
+  for (int st = 0; st < StepProfile::StageCount; ++st)
+    stages[std::string(StepProfile::name(static_cast<StepProfile::Stage>(st)))] = run.profile.seconds[st];
+  report["simulation"]["stage_seconds"] = stages;
+  report["scene"] = {{"obstacle", a.obstacle},
+                     {"n", a.n},
+                     {"fabric", o.fabric.name},
+                     {"strain_limit", a.strain_limit},
+                     {"strain_threshold", threshold},
+                     {"strain_passes", a.passes}};
+  report["strain"] = {{"structural", strain_json(q.strain)},
+                      {"shear", strain_json(strain_stats(scene.model, scene.state.x, SpringKind::Shear))}};
+  report["gates"] = {{"finite", run.status == StepStatus::Ok}, {"settled", run.settled}};
+  if (other)
+    report["comparison"] = {{"strain_limit", std::string(to_string(other->scene.settings.strain_limit))},
+                            {"max_strain", other->quality.strain.max},
+                            {"p99_strain", other->quality.strain.p99},
+                            {"global_strain", other->quality.strain.global},
+                            {"settled", other->run.settled},
+                            {"iterations", other->run.iterations}};
+
+  // scene.glb and preview.png need finite positions; a failed run writes its report only.
+  const std::filesystem::path dir(a.out);
+  const bool finite = run.status != StepStatus::NonFinite && (!other || other->run.status != StepStatus::NonFinite);
+  if (finite) {
+    Scene gltf;
+    add_mesh_node(gltf, cloth_mesh(scene.model, scene.state), "cloth");
+    add_mesh_node(gltf, scene.obstacle_mesh(), "body");
+    write_scene(dir / "scene.glb", gltf);
+    const float range = std::max(0.1f, 2.0f * threshold);
+    if (other) {
+      const Finished& unlimited = o.strain_limit == StrainLimit::None ? main_run : *other;
+      const Finished& limited = o.strain_limit == StrainLimit::None ? *other : main_run;
+      write_png(dir / "preview.png", compose_side_by_side({picture(unlimited, range), picture(limited, range)}, {}));
+    } else {
+      write_png(dir / "preview.png", picture(main_run, range));
+    }
+  }
+  write_file_atomic(dir / "report.json", report.dump(2) + "\n");
+
+  if (run.status != StepStatus::Ok) {
+    std::fprintf(stderr, "drape: scene: simulation failed: %s\n", std::string(to_string(run.status)).c_str());
+    std::exit(kExitQualityGate);
+  }
+  if (!run.settled) {
+    std::fprintf(stderr, "drape: scene: the cloth did not settle within %.3g s\n", a.max_time);
+    std::exit(kExitQualityGate);
+  }
+}
+
+}  // namespace
+
+void add_scene_command(CLI::App& app) {
+  auto args = std::make_shared<SceneArgs>();
+  CLI::App* cmd = app.add_subcommand("scene", "Drop a square cloth over a sphere or a table (paper fig. 7) until it settles");
+  cmd->add_option("obstacle", args->obstacle, "sphere or table")->check(CLI::IsMember({"sphere", "table"}));
+  cmd->add_option("--n", args->n, "cloth vertices per side")->capture_default_str()->check(CLI::Range(3u, 2048u));
+  cmd->add_option("--strain-limit", args->strain_limit, "none, position (Provot) or velocity (paper sec. 3.3)")
+      ->capture_default_str()->check(CLI::IsMember({"none", "position", "velocity"}));
+  cmd->add_option("--threshold", args->threshold, "stretch threshold as a fraction (default: the fabric's)")
+      ->check(CLI::Range(0.0001f, 1.0f));
+  cmd->add_option("--passes", args->passes, "maximum strain-limit passes per iteration")->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--fabric", args->fabric, "fabric preset (cotton, denim, silk, jersey, rib_knit, wool, polyester)")
+      ->capture_default_str();
+  cmd->add_option("--dt", args->time_step, "time step in seconds (default: the stability bound, eq. 4)");
+  cmd->add_option("--max-time", args->max_time, "simulated seconds before giving up on settling")->capture_default_str();
+  cmd->add_option("--out", args->out, "output directory")->capture_default_str();
+  cmd->add_flag("!--no-compare", args->compare,
+                "skip the companion run (no limit vs velocity modification) shown beside this one in preview.png");
+  cmd->callback([args] { run_scene(*args); });
+}
+
+}  // namespace drape::app

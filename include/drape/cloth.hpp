@@ -1,0 +1,251 @@
+#pragma once
+// Mass-spring cloth after Vassilev & Spanlang, "Efficient Cloth Model for Dressing Animated Virtual
+// People": springs (sec. 2.1, eq. 2), explicit Euler (eq. 3) at the stability bound (eq. 4),
+// velocity modification against super-elasticity (sec. 3.3), Provot's position modification as the
+// baseline (sec. 3.2), and collision response by velocity (eq. 5) or by force (sec. 5).
+//
+// Shape (see docs/cloth.md):
+//   ClothModel   immutable, built once by a builder: per-particle mass, springs as typed arrays per
+//                kind (all kinds in one index space, sorted by kind), the per-particle incidence
+//                lists that gather spring forces in a fixed order, and a colouring of the
+//                strain-limited springs for race-free Gauss-Seidel passes.
+//   ClothState   mutable: positions, velocities (contiguous Vec3f arrays), time, health.
+//   StepScratch  everything a step needs besides the state, allocated once; step() allocates nothing.
+//   step()       a short list of named stages, each timed into StepProfile.
+// Results do not depend on the number of OpenMP threads: every per-particle sum runs over the
+// model's fixed incidence order and every reduction over fixed blocks.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drape/collider.hpp"
+#include "drape/fabric.hpp"
+#include "drape/mesh.hpp"
+
+namespace drape {
+
+// Spring kinds, in the order their springs are stored. Later kinds (seams, support springs, skin
+// anchors) append here; a kind with no springs costs nothing.
+enum class SpringKind : uint8_t {
+  Structural,  // grid [i,j]-[i+1,j] and [i,j]-[i,j+1]; triangle mesh edges
+  Shear,       // grid [i,j]-[i+1,j+1] and [i+1,j]-[i,j+1]
+  Flexion,     // grid [i,j]-[i+2,j] and [i,j]-[i,j+2]; triangle mesh: across each interior edge
+  Seam,        // sewing springs between panels (rest length usually 0)
+  Count
+};
+inline constexpr size_t kSpringKindCount = static_cast<size_t>(SpringKind::Count);
+std::string_view to_string(SpringKind kind);
+
+// One kind's springs as a range [begin, end) of the model's spring arrays.
+struct SpringRange {
+  uint32_t begin = 0;
+  uint32_t end = 0;
+  uint32_t size() const { return end - begin; }
+};
+
+// Immutable cloth model. Build with a builder (grid_cloth, mesh_cloth) or fill a ClothSpec and
+// compile it; never edit a model in place.
+struct ClothModel {
+  Fabric fabric;
+
+  // Particles.
+  std::vector<float> mass;          // kg
+  std::vector<float> inverse_mass;  // 1/kg; 0 for pinned (kinematic) particles
+  std::vector<float> drag_area;     // m^2 of cloth each particle represents (air drag)
+  std::vector<Vec3f> rest_position; // the layout the model was built from
+  std::vector<Vec2f> flat_position; // position on the flat pattern (metres); TEXCOORD_0 on output
+  std::vector<Tri> triangles;       // for output and rendering (grid: two per cell)
+
+  // Springs, sorted by kind (kind_range). Forces follow eq. 2 plus damping along the spring:
+  // f_a = (stiffness (|d| - rest) + damping (v_b - v_a).u) u, u = d/|d|, d = x_b - x_a; f_b = -f_a.
+  std::vector<uint32_t> spring_a, spring_b;
+  std::vector<float> rest_length;  // m
+  std::vector<float> stiffness;    // N/m
+  std::vector<float> damping;      // N s/m
+  std::array<SpringRange, kSpringKindCount> kind_range{};
+
+  // Per-particle incidence (CSR): springs touching particle i are incident_spring[incident_begin[i]
+  // .. incident_begin[i+1]), with incident_sign +1 where i is the spring's a end and -1 where b.
+  std::vector<uint32_t> incident_begin;
+  std::vector<uint32_t> incident_spring;
+  std::vector<float> incident_sign;
+
+  // Strain-limited springs (structural by default) grouped into colours that share no particle, so
+  // a Gauss-Seidel pass runs each colour in parallel without races and in a fixed order.
+  std::vector<uint32_t> limit_a, limit_b;
+  std::vector<float> limit_rest;
+  std::vector<uint32_t> limit_colour_begin;  // colour c is [begin[c], begin[c+1])
+
+  // Grid builders fill these (0 for meshes): particle index of grid vertex (ix, iy) is iy * nx + ix.
+  uint32_t grid_nx = 0, grid_ny = 0;
+
+  size_t particle_count() const { return mass.size(); }
+  size_t spring_count() const { return spring_a.size(); }
+  SpringRange range(SpringKind kind) const { return kind_range[static_cast<size_t>(kind)]; }
+  float total_mass() const;
+  // Largest time step the stability bound allows (eq. 4), see stable_time_step().
+  float stable_time_step() const;
+};
+
+// A model under construction: particles and springs in any order. compile() sorts the springs by
+// kind, builds the incidence lists, the colouring and the damping, and checks every index.
+struct ClothSpec {
+  Fabric fabric;
+  std::vector<Vec3f> positions;
+  std::vector<Vec2f> flat_positions;  // empty: derived from positions (x, z)
+  std::vector<float> mass;            // kg per particle
+  std::vector<float> drag_area;       // m^2 per particle
+  std::vector<uint8_t> pinned;        // empty or one per particle
+  std::vector<Tri> triangles;
+  struct Spring {
+    uint32_t a, b;
+    float rest_length, stiffness;
+    SpringKind kind;
+  };
+  std::vector<Spring> springs;
+  // Kinds whose springs velocity / position modification limit (bit i = SpringKind i).
+  uint32_t limited_kinds = 1u << static_cast<unsigned>(SpringKind::Structural);
+  uint32_t grid_nx = 0, grid_ny = 0;
+};
+ClothModel compile(ClothSpec spec);
+
+// Rectangular-topology cloth (sec. 2.1): nx x ny particles over width x height metres, structural,
+// shear and flexion springs exactly as the paper lists them. The cloth lies in the plane spanned by
+// `u_axis` (weft, ix) and `v_axis` (warp, iy) through `origin` (the corner of particle 0).
+struct GridClothOptions {
+  uint32_t nx = 64, ny = 64;
+  float width = 1.0f, height = 1.0f;
+  Vec3f origin{-0.5f, 0.4f, -0.5f};
+  Vec3f u_axis{1.0f, 0.0f, 0.0f};
+  Vec3f v_axis{0.0f, 0.0f, 1.0f};
+};
+ClothSpec grid_cloth_spec(const Fabric& fabric, const GridClothOptions& options);
+ClothModel grid_cloth(const Fabric& fabric, const GridClothOptions& options);
+
+// Triangle-mesh cloth: a spring on every edge (structural), a bending spring across every interior
+// edge between the two opposite vertices (flexion). Rest lengths, masses and warp/weft anisotropy
+// come from the flat pattern coordinates (mesh.uvs, metres) when the mesh has them, else from the
+// 3D positions. InputError(source, ...) for an empty mesh, bad indices or degenerate triangles.
+ClothSpec mesh_cloth_spec(const Mesh& mesh, const Fabric& fabric, const std::string& source);
+ClothModel mesh_cloth(const Mesh& mesh, const Fabric& fabric, const std::string& source);
+
+// Why a simulation stopped being trustworthy. Sticky: once set, step() refuses to continue.
+enum class StepStatus : uint8_t { Ok, NonFinite, Exploded };
+std::string_view to_string(StepStatus status);
+
+struct ClothState {
+  std::vector<Vec3f> x;  // positions (m)
+  std::vector<Vec3f> v;  // velocities (m/s)
+  double time = 0;       // simulated seconds
+  uint64_t iterations = 0;
+  StepStatus status = StepStatus::Ok;
+  // Measured at the end of the last step.
+  float max_speed = 0;        // m/s
+  double kinetic_energy = 0;  // J
+};
+// The model's rest layout, at rest.
+ClothState initial_state(const ClothModel& model);
+
+enum class StrainLimit : uint8_t { None, Position, Velocity };
+std::string_view to_string(StrainLimit limit);
+enum class CollisionResponse : uint8_t { Velocity, Force };
+
+struct StepSettings {
+  float time_step = 0;  // s; 0: the model's stable_time_step()
+  Vec3f gravity{0.0f, -9.81f, 0.0f};
+  StrainLimit strain_limit = StrainLimit::Velocity;
+  float strain_threshold = 0.05f;  // fraction of rest length
+  int strain_passes = 4;           // maximum Gauss-Seidel passes per step
+  // Velocity: eq. 5 with Coulomb friction, relative to the surface velocity, for static and slowly
+  // moving bodies. Force: sec. 5's response for animated bodies, a force along the surface normal
+  // proportional to the depth inside the collision thickness.
+  CollisionResponse collision_response = CollisionResponse::Velocity;
+  float max_speed = 50.0f;  // m/s; faster means the integration exploded
+};
+// Settings with the fabric's strain threshold.
+StepSettings default_step_settings(const ClothModel& model);
+
+// Wall-clock seconds per stage, summed over steps, and what the stages measured.
+struct StepProfile {
+  enum Stage : uint8_t {
+    UpdateColliders,
+    DetectContacts,
+    SpringForces,
+    IntegrateVelocities,
+    ContactForces,
+    LimitStrainVelocity,
+    RespondToContacts,
+    IntegratePositions,
+    LimitStrainPosition,
+    CheckHealth,
+    StageCount
+  };
+  std::array<double, StageCount> seconds{};
+  uint64_t steps = 0;
+  uint64_t strain_passes = 0;        // Gauss-Seidel passes run (velocity or position modification)
+  uint64_t strain_corrections = 0;   // spring corrections applied in those passes
+  uint64_t steps_at_pass_limit = 0;  // steps whose last pass still had to correct springs
+  uint64_t contacts = 0;             // particle-steps in contact
+  static std::string_view name(Stage stage);
+  double total_seconds() const;
+};
+
+// Working memory for step(), sized for one model (and at most `max_colliders` colliders).
+class StepScratch {
+ public:
+  StepScratch() = default;
+  explicit StepScratch(const ClothModel& model, size_t max_colliders = 4);
+  void resize(const ClothModel& model, size_t max_colliders = 4);
+
+  std::vector<Vec3f> spring_force;        // per spring: force on its a end
+  std::vector<ContactSample> contact;     // per particle: nearest contact this step
+  std::vector<ContactSample> contact_tmp; // per particle: second and later colliders
+  std::vector<double> block_energy;       // per block: kinetic energy (fixed-order reduction)
+  std::vector<float> block_speed;         // per block: max speed squared
+  std::vector<uint32_t> block_count;      // per block: counters (contacts, corrections)
+  size_t max_colliders = 0;
+};
+
+// Advances the state by one time step. Colliders are brought to the new time (update()), queried
+// once per step, and answered with the chosen response. Returns the state's status: anything but
+// Ok means the state is no longer physical and the caller must stop and report it.
+StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* const> colliders,
+                const StepSettings& settings, StepScratch& scratch, StepProfile* profile = nullptr);
+
+// --- Measurements -------------------------------------------------------------------------------
+
+// Stretch (l - l0) / l0 of one kind's springs (structural by default).
+struct StrainStats {
+  float max = 0;     // largest stretch
+  float p99 = 0;     // 99th percentile of stretch
+  float mean_abs = 0;
+  float min = 0;     // largest compression (negative)
+  float global = 0;  // (sum l - sum l0) / sum l0: whether the cloth as a whole grew
+};
+StrainStats strain_stats(const ClothModel& model, std::span<const Vec3f> x,
+                         SpringKind kind = SpringKind::Structural);
+// Per particle: the largest stretch of its incident springs of `kind` (for colouring pictures).
+std::vector<float> particle_strain(const ClothModel& model, std::span<const Vec3f> x,
+                                   SpringKind kind = SpringKind::Structural);
+
+// Kinetic + spring potential energy (J), and the work gravity could still do (m g . x with g).
+struct ClothEnergy {
+  double kinetic = 0, elastic = 0, gravitational = 0;
+  double total() const { return kinetic + elastic + gravitational; }
+};
+ClothEnergy cloth_energy(const ClothModel& model, const ClothState& state, const Vec3f& gravity);
+
+// Sum of all spring forces (internal forces: zero up to rounding) and per-particle spring force.
+std::vector<Vec3f> spring_forces_per_particle(const ClothModel& model, std::span<const Vec3f> x,
+                                              std::span<const Vec3f> v);
+
+// FNV-1a over the bits of positions and velocities: equal states, equal hashes.
+uint64_t state_hash(const ClothState& state);
+
+// The cloth as a mesh: current positions, TEXCOORD_0 = flat coordinates (metres), normals.
+Mesh cloth_mesh(const ClothModel& model, const ClothState& state, std::string name = "cloth");
+
+}  // namespace drape

@@ -1,0 +1,78 @@
+#pragma once
+// The draping scenes of Vassilev & Spanlang fig. 7 (a square cloth dropped over a sphere or a
+// table), written once and shared by the `drape scene` command, the tests and the benchmarks.
+//
+// Sphere: radius 0.3 m at the origin; the 1 m cloth starts flat 0.1 m above its top (y = 0.4 m),
+// the same layout as ../shared/peers (Blender, Bullet) with their z-up turned into drape's y-up;
+// particle (ix, iy) is at x = -0.5 + ix h, z = -0.5 + iy h, index iy n + ix as in the peers.
+// Table: a 0.6 m square top 0.04 m thick with its top at y = 0.3 m, over a floor at y = 0.
+#include <functional>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "drape/analytic_colliders.hpp"
+#include "drape/cloth.hpp"
+
+namespace drape {
+
+enum class SceneObstacle { Sphere, Table };
+std::string_view to_string(SceneObstacle obstacle);
+
+struct ClothSceneOptions {
+  SceneObstacle obstacle = SceneObstacle::Sphere;
+  uint32_t n = 64;          // particles along each side
+  Fabric fabric = {};       // default: the "cotton" preset (make_cloth_scene fills it when name is empty)
+  StrainLimit strain_limit = StrainLimit::Velocity;
+  float strain_threshold = -1;  // < 0: the fabric's
+  int strain_passes = 4;
+  float time_step = 0;          // 0: the stability bound (eq. 4)
+};
+
+struct ClothScene {
+  ClothModel model;
+  ClothState state;
+  StepSettings settings;
+  StepScratch scratch;
+  std::vector<std::unique_ptr<AnalyticCollider>> obstacles;
+  std::vector<Collider*> colliders;  // the obstacles, as step() takes them
+
+  // Obstacles merged into one mesh (the `body` node of scene.glb).
+  Mesh obstacle_mesh() const;
+  // Exact inside test against the obstacles: > 0 outside.
+  float obstacle_distance(const Vec3f& p) const;
+};
+ClothScene make_cloth_scene(const ClothSceneOptions& options);
+
+// When a run counts as settled: the fastest particle slower than `speed` for `duration` seconds of
+// simulated time, after at least `min_time`. Runs stop at `max_time` unsettled.
+struct SettleCriteria {
+  float speed = 0.05f;      // m/s
+  double duration = 0.3;    // s
+  double min_time = 0.5;    // s
+  double max_time = 12.0;   // s
+};
+
+struct SceneRun {
+  bool settled = false;
+  double settled_at = 0;  // simulated seconds when the settling window began
+  StepStatus status = StepStatus::Ok;
+  uint64_t iterations = 0;
+  double wall_seconds = 0;  // stepping only
+  StepProfile profile;
+};
+// Steps until settled, failed (status) or max_time. `progress` (may be empty) is called about every
+// 0.25 s of simulated time.
+SceneRun run_until_settled(ClothScene& scene, const SettleCriteria& criteria = {},
+                           const std::function<void(const ClothState&)>& progress = {});
+
+// DESIGN.md's `quality` measures for a scene (no seams: the seam gaps are 0).
+struct SceneQuality {
+  StrainStats strain;  // structural springs
+  size_t penetrating_vertices = 0;
+  double penetration_fraction = 0;
+  float max_penetration = 0;  // m
+};
+SceneQuality scene_quality(const ClothScene& scene);
+
+}  // namespace drape

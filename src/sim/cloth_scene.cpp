@@ -1,0 +1,111 @@
+// The fig. 7 scenes: a square cloth dropped over a sphere or a table (see drape/cloth_scene.hpp).
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "drape/cloth_scene.hpp"
+#include "drape/error.hpp"
+
+namespace drape {
+
+std::string_view to_string(SceneObstacle obstacle) {
+  return obstacle == SceneObstacle::Sphere ? "sphere" : "table";
+}
+
+ClothScene make_cloth_scene(const ClothSceneOptions& o) {
+  if (o.n < 3 || o.n > 2048) throw InputError("--n", "the cloth needs between 3 and 2048 vertices per side");
+  if (o.strain_passes < 1 || o.strain_passes > 1000) throw InputError("--passes", "strain passes must be 1..1000");
+  ClothScene s;
+  const Fabric fabric = o.fabric.name.empty() ? fabric_or_throw("cotton") : o.fabric;
+  GridClothOptions grid;
+  grid.nx = grid.ny = o.n;
+  grid.width = grid.height = 1.0f;
+  grid.origin = Vec3f(-0.5f, 0.4f, -0.5f);
+  grid.u_axis = Vec3f::UnitX();
+  grid.v_axis = Vec3f::UnitZ();
+  s.model = grid_cloth(fabric, grid);
+  s.state = initial_state(s.model);
+  s.settings = default_step_settings(s.model);
+  s.settings.strain_limit = o.strain_limit;
+  if (o.strain_threshold >= 0) {
+    if (!(o.strain_threshold >= 1e-4f && o.strain_threshold <= 1.0f))
+      throw InputError("--threshold", "the strain threshold must be between 0.0001 and 1");
+    s.settings.strain_threshold = o.strain_threshold;
+  }
+  s.settings.strain_passes = o.strain_passes;
+  s.settings.time_step = o.time_step;
+  if (o.obstacle == SceneObstacle::Sphere) {
+    s.obstacles.push_back(std::make_unique<SphereCollider>(Vec3f::Zero(), 0.3f));
+  } else {
+    s.obstacles.push_back(std::make_unique<BoxCollider>(Vec3f(0.0f, 0.28f, 0.0f), Vec3f(0.3f, 0.02f, 0.3f)));
+    s.obstacles.push_back(std::make_unique<PlaneCollider>(Vec3f::Zero(), Vec3f::UnitY(), 2.0f));
+  }
+  for (auto& ob : s.obstacles) s.colliders.push_back(ob.get());
+  s.scratch.resize(s.model, s.colliders.size());
+  return s;
+}
+
+Mesh ClothScene::obstacle_mesh() const {
+  Mesh merged;
+  merged.name = "body";
+  for (const auto& ob : obstacles) {
+    const Mesh m = ob->mesh();
+    const uint32_t base = static_cast<uint32_t>(merged.positions.size());
+    merged.positions.insert(merged.positions.end(), m.positions.begin(), m.positions.end());
+    merged.normals.insert(merged.normals.end(), m.normals.begin(), m.normals.end());
+    for (const Tri& t : m.triangles) merged.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  }
+  return merged;
+}
+
+float ClothScene::obstacle_distance(const Vec3f& p) const {
+  float d = std::numeric_limits<float>::infinity();
+  for (const auto& ob : obstacles) d = std::min(d, ob->signed_distance(p, nullptr));
+  return d;
+}
+
+SceneRun run_until_settled(ClothScene& scene, const SettleCriteria& criteria,
+                           const std::function<void(const ClothState&)>& progress) {
+  SceneRun run;
+  const auto start = std::chrono::steady_clock::now();
+  double calm_since = -1, next_report = 0.25;
+  while (scene.state.time < criteria.max_time) {
+    run.status = step(scene.model, scene.state, scene.colliders, scene.settings, scene.scratch, &run.profile);
+    if (run.status != StepStatus::Ok) break;
+    const double t = scene.state.time;
+    // Settled: calm (every particle slower than the threshold) for the whole window.
+    if (scene.state.max_speed < criteria.speed) {
+      if (calm_since < 0) calm_since = t;
+      if (t - calm_since >= criteria.duration && t >= criteria.min_time) {
+        run.settled = true;
+        run.settled_at = calm_since;
+        break;
+      }
+    } else {
+      calm_since = -1;
+    }
+    if (progress && t >= next_report) {
+      progress(scene.state);
+      next_report += 0.25;
+    }
+  }
+  run.iterations = scene.state.iterations;
+  run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+SceneQuality scene_quality(const ClothScene& scene) {
+  SceneQuality q;
+  q.strain = strain_stats(scene.model, scene.state.x, SpringKind::Structural);
+  for (const Vec3f& p : scene.state.x) {
+    const float d = scene.obstacle_distance(p);
+    if (d < 0) {
+      ++q.penetrating_vertices;
+      q.max_penetration = std::max(q.max_penetration, -d);
+    }
+  }
+  q.penetration_fraction = scene.state.x.empty() ? 0.0 : static_cast<double>(q.penetrating_vertices) / static_cast<double>(scene.state.x.size());
+  return q;
+}
+
+}  // namespace drape

@@ -1,0 +1,117 @@
+#pragma once
+// Pure kernels of the cloth step: one spring, one over-stretched spring, one colliding particle.
+// Plain values in, plain values out, so each is unit-tested alone and easy to move to SIMD or a GPU.
+#include <algorithm>
+#include <cmath>
+
+#include "drape/mesh.hpp"
+
+namespace drape::sim {
+
+// Eq. 2 plus damping along the spring: the force on end a (end b gets its negative).
+// A zero-length spring with rest length 0 (a closed seam) gives zero force, not NaN.
+inline Vec3f spring_force(const Vec3f& xa, const Vec3f& xb, const Vec3f& va, const Vec3f& vb, float rest,
+                          float stiffness, float damping) {
+  const Vec3f d = xb - xa;
+  const float len2 = d.squaredNorm();
+  const float inv_len = len2 > 1e-24f ? 1.0f / std::sqrt(len2) : 0.0f;
+  const Vec3f u = d * inv_len;
+  const float len = len2 * inv_len;
+  return (stiffness * (len - rest) + damping * (vb - va).dot(u)) * u;
+}
+
+// Velocity modification (sec. 3.3) of one spring, as the paper does it: a spring longer than
+// max_length that is still stretching loses the stretching components of its end velocities, i.e.
+// the part of each end's velocity along the spring that points away from the other end (v1t, v2t
+// of fig. 1) is set to zero; motion towards the other end is kept. A spring still shorter than
+// max_length that would pass it within dt loses just enough of those components to end the step
+// at max_length. The components are judged in the world frame, not relative to each other: that
+// is what lets one pass hold a long hanging chain (every spring stops its own lower end), and it
+// also means the modification dissipates energy, which draping wants. Returns true if it
+// changed a velocity by more than `tolerance` / dt along the spring.
+inline bool limit_spring_velocity(const Vec3f& xa, const Vec3f& xb, Vec3f& va, Vec3f& vb, float wa, float wb,
+                                  float max_length, float dt, float tolerance) {
+  const Vec3f d = xb - xa;
+  const float len = d.norm();
+  if (len <= 0) return false;
+  const Vec3f u = d / len;
+  const float ua = va.dot(u), ub = vb.dot(u);
+  const float rate = ub - ua;
+  const float allowed = std::max(0.0f, (max_length - len) / dt);
+  const float excess = rate - allowed;
+  if (excess <= 0) return false;
+  // Stretching components: a moving away from b (ua < 0), b moving away from a (ub > 0).
+  // Pinned ends (inverse mass 0) are kinematic and keep their velocity.
+  const float sa = wa > 0 ? std::min(ua, 0.0f) : 0.0f, sb = wb > 0 ? std::max(ub, 0.0f) : 0.0f;
+  const float stretching = sb - sa;
+  if (stretching <= 0) return false;
+  const float fraction = len >= max_length ? 1.0f : std::min(1.0f, excess / stretching);
+  va -= (fraction * sa) * u;
+  vb -= (fraction * sb) * u;
+  return fraction * stretching * dt > tolerance;
+}
+
+// Position modification (Provot 1995, sec. 3.2) of one spring: ends moved towards each other,
+// mass-weighted, until the spring is max_length long. Returns true if it corrected.
+inline bool limit_spring_position(Vec3f& xa, Vec3f& xb, float wa, float wb, float max_length, float tolerance) {
+  const float w = wa + wb;
+  if (w <= 0) return false;
+  const Vec3f d = xb - xa;
+  const float len = d.norm();
+  const float excess = len - max_length;
+  if (excess <= 0) return false;
+  const Vec3f correction = d * (excess / (len * w));
+  xa += wa * correction;
+  xb -= wb * correction;
+  return excess > tolerance;
+}
+
+// Collision response by velocity (eq. 5, v = C_fric v_t - C_refl v_n) for one particle whose
+// nearest surface is `distance` away along `normal`, moving with `surface_velocity`. Contact when
+// the particle would end the step closer than `thickness`. A particle already inside the thickness
+// layer is first put back on it (position). The normal velocity relative to the surface is
+// reflected with C_refl = restitution; C_fric follows Coulomb's law from the normal velocity change,
+// C_fric = max(0, 1 - mu |dv_n| / |v_t|), so friction does not depend on the time step.
+// Returns true on contact.
+inline bool respond_contact_velocity(Vec3f& x, Vec3f& v, float distance, const Vec3f& normal,
+                                     const Vec3f& surface_velocity, float thickness, float friction,
+                                     float restitution, float dt) {
+  const float vn = v.dot(normal);
+  if (distance + dt * vn >= thickness) return false;
+  if (distance < thickness) {
+    x += (thickness - distance) * normal;
+    distance = thickness;
+  }
+  const float sn = surface_velocity.dot(normal);
+  const float vn_rel = vn - sn;
+  const float target_rel = vn_rel < 0 ? -restitution * vn_rel : vn_rel;
+  const float vn_new = std::max(sn + target_rel, (thickness - distance) / dt);
+  const float dvn = vn_new - vn;
+  const Vec3f vt_rel = (v - surface_velocity) - vn_rel * normal;
+  const float vt_len = vt_rel.norm();
+  const float c_fric = vt_len > 0 ? std::max(0.0f, 1.0f - friction * std::abs(dvn) / vt_len) : 0.0f;
+  v = (surface_velocity - sn * normal) + c_fric * vt_rel + vn_new * normal;
+  return true;
+}
+
+// Collision response by force (sec. 5, for animated bodies): inside the thickness layer, a force
+// along the normal proportional to the depth plus critical damping of the normal velocity relative
+// to the surface, applied over dt as a velocity change; Coulomb friction from the same impulse.
+// The spring rate is m (0.5/dt)^2, well inside the explicit stability limit. Returns true on contact.
+inline bool respond_contact_force(Vec3f& v, float distance, const Vec3f& normal, const Vec3f& surface_velocity,
+                                  float thickness, float friction, float dt) {
+  const float depth = thickness - distance;
+  if (depth <= 0) return false;
+  const float omega = 0.5f / dt;
+  const Vec3f v_rel = v - surface_velocity;
+  const float vn_rel = v_rel.dot(normal);
+  const float dvn = dt * (omega * omega * depth - 2.0f * omega * vn_rel);
+  if (dvn <= 0) return true;
+  const Vec3f vt_rel = v_rel - vn_rel * normal;
+  const float vt_len = vt_rel.norm();
+  const float c_fric = vt_len > 0 ? std::max(0.0f, 1.0f - friction * dvn / vt_len) : 0.0f;
+  v = surface_velocity + c_fric * vt_rel + (vn_rel + dvn) * normal;
+  return true;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,155 @@
+// Physics invariants of the cloth model (STYLE.md): zero force at rest, invariance under a rigid
+// rotation, internal forces summing to zero, energy that does not grow under damping, failures that
+// are reported rather than hidden.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "drape/analytic_colliders.hpp"
+#include "drape/cloth.hpp"
+
+namespace drape {
+namespace {
+
+ClothModel test_grid(uint32_t n = 12) {
+  GridClothOptions o;
+  o.nx = o.ny = n;
+  return grid_cloth(fabric_or_throw("cotton"), o);
+}
+
+// The rest layout with every particle moved by up to `amount` metres and given a random velocity.
+ClothState perturbed(const ClothModel& m, float amount, uint32_t seed = 7) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  ClothState s = initial_state(m);
+  for (size_t i = 0; i < m.particle_count(); ++i) {
+    s.x[i] += amount * Vec3f(u(rng), u(rng), u(rng));
+    s.v[i] = 0.2f * Vec3f(u(rng), u(rng), u(rng));
+  }
+  return s;
+}
+
+TEST(ClothPhysics, ZeroForceAtRest) {
+  const ClothModel m = test_grid();
+  const ClothState s = initial_state(m);
+  for (const Vec3f& f : spring_forces_per_particle(m, s.x, s.v)) EXPECT_LT(f.norm(), 1e-5f);
+}
+
+TEST(ClothPhysics, InternalForcesSumToZero) {
+  const ClothModel m = test_grid();
+  const ClothState s = perturbed(m, 0.01f);
+  Vec3f sum = Vec3f::Zero();
+  float largest = 0;
+  for (const Vec3f& f : spring_forces_per_particle(m, s.x, s.v)) {
+    sum += f;
+    largest = std::max(largest, f.norm());
+  }
+  ASSERT_GT(largest, 0.01f);
+  EXPECT_LT(sum.norm(), 1e-5f * largest * static_cast<float>(m.particle_count()));
+}
+
+TEST(ClothPhysics, ForcesAreInvariantUnderARigidRotation) {
+  const ClothModel m = test_grid();
+  const ClothState s = perturbed(m, 0.01f);
+  const Eigen::Matrix3f r = Eigen::AngleAxisf(0.7f, Vec3f(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3f shift(0.3f, -1.0f, 2.0f);
+  ClothState rotated = s;
+  for (size_t i = 0; i < m.particle_count(); ++i) {
+    rotated.x[i] = r * s.x[i] + shift;
+    rotated.v[i] = r * s.v[i];
+  }
+  const auto f = spring_forces_per_particle(m, s.x, s.v);
+  const auto fr = spring_forces_per_particle(m, rotated.x, rotated.v);
+  for (size_t i = 0; i < f.size(); ++i) EXPECT_LT((fr[i] - r * f[i]).norm(), 1e-4f * (1 + f[i].norm())) << i;
+}
+
+TEST(ClothPhysics, StepMatchesTheKernelsForcesAndEquation3) {
+  // With no gravity, drag or limits, one step is exactly v += dt f / m, x += dt v.
+  ClothModel m = test_grid(8);
+  m.fabric.air_damping = 0;
+  m.fabric.air_drag = 0;
+  ClothState s = perturbed(m, 0.005f);
+  const ClothState before = s;
+  StepSettings settings = default_step_settings(m);
+  settings.gravity = Vec3f::Zero();
+  settings.strain_limit = StrainLimit::None;
+  StepScratch scratch(m);
+  ASSERT_EQ(step(m, s, {}, settings, scratch), StepStatus::Ok);
+  const float dt = m.stable_time_step();
+  const auto f = spring_forces_per_particle(m, before.x, before.v);
+  for (size_t i = 0; i < m.particle_count(); ++i) {
+    const Vec3f v = before.v[i] + dt * m.inverse_mass[i] * f[i];
+    EXPECT_LT((s.v[i] - v).norm(), 1e-4f * (1 + v.norm()));
+    EXPECT_LT((s.x[i] - (before.x[i] + dt * s.v[i])).norm(), 1e-6f);
+  }
+}
+
+TEST(ClothPhysics, EnergyDoesNotGrowWithoutExternalForces) {
+  const ClothModel m = test_grid(16);
+  ClothState s = perturbed(m, 0.004f, 3);
+  StepSettings settings = default_step_settings(m);
+  settings.gravity = Vec3f::Zero();
+  settings.strain_limit = StrainLimit::None;
+  StepScratch scratch(m);
+  const double e0 = cloth_energy(m, s, settings.gravity).total();
+  double previous = e0;
+  for (int block = 0; block < 20; ++block) {
+    for (int k = 0; k < 50; ++k) ASSERT_EQ(step(m, s, {}, settings, scratch), StepStatus::Ok);
+    const double e = cloth_energy(m, s, settings.gravity).total();
+    // Symplectic Euler's energy wobbles by O(dt); under damping it must still fall over time.
+    EXPECT_LE(e, previous * 1.01 + 1e-12) << "after " << (block + 1) * 50 << " steps";
+    previous = std::min(previous, e);
+  }
+  EXPECT_LT(previous, 0.5 * e0);
+}
+
+TEST(ClothPhysics, TooLargeATimeStepIsReportedNotHidden) {
+  const ClothModel m = test_grid(12);
+  ClothState s = perturbed(m, 0.01f);
+  StepSettings settings = default_step_settings(m);
+  settings.strain_limit = StrainLimit::None;
+  settings.time_step = 40 * m.stable_time_step();
+  StepScratch scratch(m);
+  StepStatus status = StepStatus::Ok;
+  for (int k = 0; k < 2000 && status == StepStatus::Ok; ++k) status = step(m, s, {}, settings, scratch);
+  EXPECT_NE(status, StepStatus::Ok);
+  // Sticky: the state refuses further steps.
+  const uint64_t iterations = s.iterations;
+  EXPECT_EQ(step(m, s, {}, settings, scratch), status);
+  EXPECT_EQ(s.iterations, iterations);
+}
+
+TEST(ClothPhysics, PinnedParticlesStayWhereTheyAre) {
+  ClothSpec spec = grid_cloth_spec(fabric_or_throw("cotton"), GridClothOptions{.nx = 10, .ny = 10});
+  spec.pinned.assign(spec.positions.size(), 0);
+  spec.pinned[0] = spec.pinned[9] = 1;
+  const ClothModel m = compile(std::move(spec));
+  ClothState s = initial_state(m);
+  StepSettings settings = default_step_settings(m);
+  StepScratch scratch(m);
+  for (int k = 0; k < 500; ++k) ASSERT_EQ(step(m, s, {}, settings, scratch), StepStatus::Ok);
+  EXPECT_EQ(s.x[0], m.rest_position[0]);
+  EXPECT_EQ(s.x[9], m.rest_position[9]);
+  EXPECT_LT(s.x[55].y(), m.rest_position[55].y() - 0.05f);  // the rest hangs down
+}
+
+TEST(ClothPhysics, ForceResponseHoldsTheClothAboveAMovingFloor) {
+  // Sec. 5: a floor rising at 0.2 m/s under a resting cloth carries it up without letting it through.
+  const ClothModel m = test_grid(10);
+  ClothState s = initial_state(m);
+  PlaneCollider floor(Vec3f(0, 0.3f, 0), Vec3f::UnitY());
+  floor.set_velocity(Vec3f(0, 0.2f, 0));
+  Collider* colliders[] = {&floor};
+  StepSettings settings = default_step_settings(m);
+  settings.collision_response = CollisionResponse::Force;
+  StepScratch scratch(m, 1);
+  while (s.time < 1.0) ASSERT_EQ(step(m, s, colliders, settings, scratch), StepStatus::Ok);
+  for (const Vec3f& p : s.x) {
+    EXPECT_GT(floor.signed_distance(p, nullptr), 0.0f);
+    EXPECT_LT(floor.signed_distance(p, nullptr), 0.02f);
+  }
+}
+
+}  // namespace
+}  // namespace drape

@@ -13,6 +13,7 @@
 #include <tiny_gltf.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -734,8 +735,22 @@ void GltfWriter::add_scene(const Scene& scene) {
     if (node.parent < 0) gs.nodes.push_back(static_cast<int>(i));
     model_.nodes.push_back(gn);
   }
-  model_.scenes.push_back(gs);
-  model_.defaultScene = 0;
+  // A mesh on no node would be invisible (and merge_scene places it at the origin): give it a root node.
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    const bool placed = std::any_of(scene.nodes.begin(), scene.nodes.end(),
+                                    [&](const Node& n) { return n.mesh == static_cast<int>(m); });
+    if (placed) continue;
+    tinygltf::Node gn;
+    gn.name = scene.meshes[m].name;
+    gn.mesh = static_cast<int>(m);
+    gs.nodes.push_back(static_cast<int>(model_.nodes.size()));
+    model_.nodes.push_back(gn);
+  }
+  // tinygltf writes a scene without nodes as null, which no reader accepts: only non-empty scenes.
+  if (!gs.nodes.empty()) {
+    model_.scenes.push_back(gs);
+    model_.defaultScene = 0;
+  }
 
   for (const Skin& skin : scene.skins) {
     tinygltf::Skin gk;

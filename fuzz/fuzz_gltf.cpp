@@ -1,0 +1,7 @@
+// libFuzzer target for the glTF reader: JSON .gltf, and GLB when the input starts with the glTF magic
+// (see fuzz_target.hpp).
+#include "fuzz_target.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  return drape::fuzz::parse_and_round_trip(data, size, drape::MeshFormat::Gltf, "fuzz.gltf");
+}

@@ -83,7 +83,7 @@ struct RenderOptions {
   int width = 1200, height = 600;  // the whole picture, panels side by side
   std::vector<ViewSpec> views{{"front", 0.0f}, {"side", 270.0f}, {"back", 180.0f}};
   int supersample = 3;             // samples per pixel along each axis (anti-aliasing); lowered for huge pictures
-  float elevation_degrees = 6.0f;  // camera looks slightly down, so the floor shows
+  float elevation_degrees = 6.0f;  // camera looks slightly down, so the floor shows (|e| <= 80)
   // Scale in picture pixels per metre; 0 fits the scene. Fix it to compare pictures of different
   // scenes (frames of an animation, two simulation methods) at the same size.
   float pixels_per_metre = 0.0f;

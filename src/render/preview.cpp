@@ -256,6 +256,8 @@ Image render_views(const std::vector<RenderItem>& items, const RenderOptions& op
   if (static_cast<int64_t>(options.width) * options.height > (int64_t{1} << 26))
     throw std::invalid_argument("render: picture larger than 64 megapixels");
   if (options.supersample < 1 || options.supersample > 8) throw std::invalid_argument("render: supersample must be 1..8");
+  if (!(std::abs(options.elevation_degrees) <= 80.0f))
+    throw std::invalid_argument("render: camera elevation must be within +-80 degrees");
   const Scene scene = gather(items);
 
   // Layout: title band on top, view labels below the panels, legend strip on the right.

@@ -216,6 +216,9 @@ TEST(Render, NothingToDrawIsAClearError) {
   RenderOptions no_views;
   no_views.views.clear();
   EXPECT_THROW(render_views({body_item(sphere)}, no_views), std::invalid_argument);
+  RenderOptions from_above;
+  from_above.elevation_degrees = 90.0f;
+  EXPECT_THROW(render_views({body_item(sphere)}, from_above), std::invalid_argument);
   RenderOptions huge;
   huge.width = huge.height = 16384;  // refused before anything is allocated
   EXPECT_THROW(render_views({body_item(sphere)}, huge), std::invalid_argument);

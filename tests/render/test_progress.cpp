@@ -67,6 +67,7 @@ TEST(Progress, UnknownTotalAndLongDetailFitTheLine) {
   EXPECT_EQ(line.find('%'), std::string::npos);
   // "\r" + at most 79 visible characters (80 columns when the output is not a terminal) + "\x1b[K".
   EXPECT_LE(line.size(), 1u + 79u + 3u);
+  p.finish();  // before the file closes
   std::fclose(f);
 }
 

@@ -164,13 +164,15 @@ void rasterize(std::span<const ScreenVertex> vertices, std::span<const Tri> tria
   for (size_t b = 0; b < static_cast<size_t>(bands); ++b) out.band_offsets[b + 1] += out.band_offsets[b];
   out.band_triangles.resize(out.band_offsets.back());
   {
-    std::vector<uint32_t> cursor(out.band_offsets.begin(), out.band_offsets.end() - 1);
+    // band_offsets[b] serves as band b's write cursor, then is restored from its neighbour.
     for (size_t t = 0; t < out.setups.size(); ++t) {
       const TriangleSetup& s = out.setups[t];
       if (s.j0 > s.j1) continue;
       for (int b = s.j0 / band_rows; b <= s.j1 / band_rows; ++b)
-        out.band_triangles[cursor[static_cast<size_t>(b)]++] = static_cast<uint32_t>(t);
+        out.band_triangles[out.band_offsets[static_cast<size_t>(b)]++] = static_cast<uint32_t>(t);
     }
+    for (size_t b = static_cast<size_t>(bands); b > 0; --b) out.band_offsets[b] = out.band_offsets[b - 1];
+    out.band_offsets[0] = 0;
   }
 
   // Each band clears and draws its own rows: no two threads touch the same pixel.
@@ -201,7 +203,8 @@ void render_depth_normal(std::span<const Vec3f> positions, std::span<const Tri> 
   const bool front = view == ViewDirection::kFront;
 
   // Orthographic projection along Z; the front view sees the largest z, so its depth is -z.
-  std::vector<ScreenVertex> screen(positions.size());
+  std::vector<ScreenVertex>& screen = scratch.projected;
+  screen.resize(positions.size());
   const float inv_pixel = 1.0f / pixel_size;
   const auto vertex_count = static_cast<int64_t>(positions.size());
 #pragma omp parallel for schedule(static) if (vertex_count > 8192)

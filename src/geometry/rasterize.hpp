@@ -67,6 +67,9 @@ struct VisibilityBuffer {
   // Working memory of rasterize(), kept so repeated calls do not allocate.
   std::vector<raster_detail::TriangleSetup> setups;
   std::vector<uint32_t> band_offsets, band_triangles;
+  // Room for a caller's projected vertices (render_depth_normal projects into it); rasterize()
+  // only reads its `vertices` argument and never touches this.
+  std::vector<ScreenVertex> projected;
 };
 
 enum class FaceCulling {

@@ -1,0 +1,42 @@
+// Object-space body collider; see bvh_collider.hpp.
+#include "collision/bvh_collider.hpp"
+
+#include <chrono>
+#include <limits>
+
+namespace drape::collision {
+
+bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactSample& out) {
+  SurfaceHit hit;
+  if (!bvh.closest(p, radius, hit)) {
+    out.distance = std::numeric_limits<float>::infinity();
+    out.normal = Vec3f::Zero();
+    out.velocity = Vec3f::Zero();
+    return false;
+  }
+  const BodySurface& surface = bvh.surface();
+  out.distance = surface.sign(hit, p) * hit.distance;
+  out.normal = surface.smooth_normal(hit);
+  out.velocity = surface.velocity(hit);
+  return true;
+}
+
+BvhCollider::BvhCollider(const Mesh& body) : surface_(body.positions, body.triangles) {
+  const auto start = std::chrono::steady_clock::now();
+  bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.memory_bytes = surface_.triangle_count() * 64;  // Embree reports no size; ~64 B per triangle node
+}
+
+void BvhCollider::set_surface(std::span<const Vec3f> positions, double t) {
+  const auto start = std::chrono::steady_clock::now();
+  surface_.set_positions(positions, t);
+  bvh_->update();
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void BvhCollider::query(std::span<const Vec3f> points, float radius, std::span<ContactSample> out) const {
+  for (size_t i = 0; i < points.size(); ++i) exact_sample(*bvh_, points[i], radius, out[i]);
+}
+
+}  // namespace drape::collision

@@ -1,0 +1,164 @@
+// Sparse narrow-band signed distance field; see sdf_collider.hpp.
+#include "collision/sdf_collider.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "collision/bvh_collider.hpp"
+
+namespace drape::collision {
+
+SdfCollider::SdfCollider(const Mesh& body, float voxel_size, float band)
+    : surface_(body.positions, body.triangles), voxel_(voxel_size), band_(band) {
+  if (!(voxel_size > 0) || !(band > 0)) throw std::invalid_argument("sdf collider: voxel size and band must be positive");
+  bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
+  build_field();
+}
+
+void SdfCollider::set_surface(std::span<const Vec3f> positions, double t) {
+  surface_.set_positions(positions, t);
+  bvh_->update();
+  build_field();
+}
+
+void SdfCollider::build_field() {
+  const auto start = std::chrono::steady_clock::now();
+  const float brick_size = voxel_ * kBrick;
+  const Bounds box = bounds(std::vector<Vec3f>(surface_.positions().begin(), surface_.positions().end()));
+  origin_ = box.min - Vec3f::Constant(band_ + voxel_);
+  for (int a = 0; a < 3; ++a)
+    dims_[a] = static_cast<int>(std::ceil((box.max[a] - box.min[a] + 2 * (band_ + voxel_)) / brick_size)) + 1;
+  const size_t brick_cells = static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1]) * static_cast<size_t>(dims_[2]);
+  auto cell_index = [&](int x, int y, int z) {
+    return (static_cast<size_t>(z) * static_cast<size_t>(dims_[1]) + static_cast<size_t>(y)) * static_cast<size_t>(dims_[0]) +
+           static_cast<size_t>(x);
+  };
+
+  // Bricks within the band of some triangle (its box grown by the band) store samples.
+  brick_of_.assign(brick_cells, kFarOutside);
+  for (const Tri& tri : surface_.triangles()) {
+    Bounds tb;
+    for (uint32_t v : tri) tb.extend(surface_.position(v));
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::floor((tb.min[a] - band_ - origin_[a]) / brick_size)));
+      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((tb.max[a] + band_ - origin_[a]) / brick_size)));
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x) brick_of_[cell_index(x, y, z)] = 0;
+  }
+  std::vector<size_t> stored_cells;
+  for (size_t c = 0; c < brick_cells; ++c)
+    if (brick_of_[c] == 0) {
+      brick_of_[c] = static_cast<int32_t>(stored_cells.size());
+      stored_cells.push_back(c);
+    }
+
+  // Exact signed samples of the stored bricks.
+  distance_.resize(stored_cells.size() * kSamples);
+  nearest_triangle_.resize(stored_cells.size() * kSamples);
+  const auto stored = static_cast<int64_t>(stored_cells.size());
+  const float infinity = std::numeric_limits<float>::infinity();
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int64_t b = 0; b < stored; ++b) {
+    const size_t c = stored_cells[static_cast<size_t>(b)];
+    const int bx = static_cast<int>(c % static_cast<size_t>(dims_[0]));
+    const int by = static_cast<int>((c / static_cast<size_t>(dims_[0])) % static_cast<size_t>(dims_[1]));
+    const int bz = static_cast<int>(c / (static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1])));
+    const Vec3f corner = origin_ + brick_size * Vec3f(static_cast<float>(bx), static_cast<float>(by), static_cast<float>(bz));
+    float* dist = &distance_[static_cast<size_t>(b) * kSamples];
+    uint32_t* tri = &nearest_triangle_[static_cast<size_t>(b) * kSamples];
+    for (int k = 0; k < kSamples; ++k) {
+      const int x = k % kSide, y = (k / kSide) % kSide, z = k / (kSide * kSide);
+      const Vec3f p = corner + voxel_ * Vec3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+      // The previous sample along an axis bounds the distance (1-Lipschitz): a small query sphere
+      // prunes most of the tree.
+      const int previous = x > 0 ? k - 1 : y > 0 ? k - kSide : z > 0 ? k - kSide * kSide : -1;
+      const float bound = previous >= 0 ? std::abs(dist[previous]) + 1.001f * voxel_ + 1e-6f : infinity;
+      SurfaceHit hit;
+      if (!bvh_->closest(p, bound, hit)) bvh_->closest(p, infinity, hit);
+      dist[k] = surface_.sign(hit, p) * hit.distance;
+      tri[k] = hit.triangle;
+    }
+  }
+
+  // The other bricks inside the body's box: far inside or far outside, judged at the brick centre.
+  const auto cells = static_cast<int64_t>(brick_cells);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int64_t c = 0; c < cells; ++c) {
+    if (brick_of_[static_cast<size_t>(c)] != kFarOutside) continue;
+    const auto uc = static_cast<size_t>(c);
+    const Vec3f centre = origin_ + brick_size * Vec3f(static_cast<float>(uc % static_cast<size_t>(dims_[0])) + 0.5f,
+                                                      static_cast<float>((uc / static_cast<size_t>(dims_[0])) % static_cast<size_t>(dims_[1])) + 0.5f,
+                                                      static_cast<float>(uc / (static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1]))) + 0.5f);
+    if (((centre - box.min).array() < 0).any() || ((centre - box.max).array() > 0).any()) continue;
+    SurfaceHit hit;
+    bvh_->closest(centre, infinity, hit);
+    if (surface_.sign(hit, centre) < 0) brick_of_[uc] = kFarInside;
+  }
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
+                        nearest_triangle_.size() * sizeof(uint32_t);
+}
+
+ContactSample SdfCollider::sample(const Vec3f& p, float radius) const {
+  const float infinity = std::numeric_limits<float>::infinity();
+  ContactSample out{infinity, Vec3f::Zero(), Vec3f::Zero()};
+  const Vec3f g = (p - origin_) / voxel_;  // continuous voxel coordinates
+  int brick[3];
+  for (int a = 0; a < 3; ++a) {
+    const float fb = std::floor(g[a] / kBrick);
+    if (!(fb >= 0.0f && fb < static_cast<float>(dims_[a]))) {  // outside the grid: beyond the band, outside
+      if (radius > band_) exact_sample(*bvh_, p, radius, out);
+      return out;
+    }
+    brick[a] = static_cast<int>(fb);
+  }
+  const int32_t b = brick_of_[(static_cast<size_t>(brick[2]) * static_cast<size_t>(dims_[1]) + static_cast<size_t>(brick[1])) *
+                                  static_cast<size_t>(dims_[0]) +
+                              static_cast<size_t>(brick[0])];
+  if (b == kFarOutside && radius <= band_) return out;
+  if (b < 0) {  // beyond the band (deep inside, or a query radius wider than the band): ask the BVH
+    exact_sample(*bvh_, p, radius, out);
+    return out;
+  }
+  // Trilinear interpolation in the brick's cell and its analytic gradient.
+  int cell[3];
+  float f[3];
+  for (int a = 0; a < 3; ++a) {
+    const float local = g[a] - static_cast<float>(brick[a] * kBrick);
+    cell[a] = std::clamp(static_cast<int>(local), 0, kBrick - 1);
+    f[a] = local - static_cast<float>(cell[a]);
+  }
+  const float* d = &distance_[static_cast<size_t>(b) * kSamples];
+  const int base = (cell[2] * kSide + cell[1]) * kSide + cell[0];
+  const float c000 = d[base], c100 = d[base + 1], c010 = d[base + kSide], c110 = d[base + kSide + 1];
+  const float c001 = d[base + kSide * kSide], c101 = d[base + kSide * kSide + 1];
+  const float c011 = d[base + kSide * kSide + kSide], c111 = d[base + kSide * kSide + kSide + 1];
+  const float x0 = c000 + f[0] * (c100 - c000), x1 = c010 + f[0] * (c110 - c010);
+  const float x2 = c001 + f[0] * (c101 - c001), x3 = c011 + f[0] * (c111 - c011);
+  const float y0 = x0 + f[1] * (x1 - x0), y1 = x2 + f[1] * (x3 - x2);
+  const float distance = y0 + f[2] * (y1 - y0);
+  if (!(distance <= radius)) return out;
+
+  const float gx0 = (c100 - c000) + f[1] * ((c110 - c010) - (c100 - c000));
+  const float gx1 = (c101 - c001) + f[1] * ((c111 - c011) - (c101 - c001));
+  const Vec3f gradient(gx0 + f[2] * (gx1 - gx0), x1 - x0 + f[2] * ((x3 - x2) - (x1 - x0)), y1 - y0);
+  const float length = gradient.norm();
+  out.distance = distance;
+  out.normal = length > 0 ? Vec3f(gradient / length) : Vec3f::UnitY();
+  // Surface velocity: at the nearest point of the triangle nearest to the closest corner sample.
+  const int corner = base + (f[0] > 0.5f ? 1 : 0) + (f[1] > 0.5f ? kSide : 0) + (f[2] > 0.5f ? kSide * kSide : 0);
+  out.velocity = surface_.velocity(surface_.closest_on(nearest_triangle_[static_cast<size_t>(b) * kSamples + static_cast<size_t>(corner)], p));
+  return out;
+}
+
+void SdfCollider::query(std::span<const Vec3f> points, float radius, std::span<ContactSample> out) const {
+  for (size_t i = 0; i < points.size(); ++i) out[i] = sample(points[i], radius);
+}
+
+}  // namespace drape::collision

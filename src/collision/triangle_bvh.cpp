@@ -1,0 +1,90 @@
+// Embree point queries for the nearest body triangle; see triangle_bvh.hpp.
+#include "collision/triangle_bvh.hpp"
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace drape::collision {
+namespace {
+
+struct QueryState {
+  const BodySurface* surface;
+  SurfaceHit* hit;
+  bool found;
+};
+
+// Embree calls this for every triangle whose box meets the query sphere; it shrinks the sphere to
+// the best distance so far, which prunes the rest of the traversal.
+bool visit_triangle(RTCPointQueryFunctionArguments* args) {
+  auto* state = static_cast<QueryState*>(args->userPtr);
+  const Vec3f p(args->query->x, args->query->y, args->query->z);
+  const SurfaceHit candidate = state->surface->closest_on(args->primID, p);
+  if (candidate.distance < args->query->radius) {
+    args->query->radius = candidate.distance;
+    *state->hit = candidate;
+    state->found = true;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+TriangleBvh::TriangleBvh(const BodySurface& surface, bool refit) : surface_(surface) {
+  device_ = rtcNewDevice(nullptr);
+  if (!device_) throw std::runtime_error("Embree: cannot create a device");
+  scene_ = rtcNewScene(device_);
+  rtcSetSceneBuildQuality(scene_, refit ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+  if (refit) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_DYNAMIC);
+  geometry_ = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+  if (refit) rtcSetGeometryBuildQuality(geometry_, RTC_BUILD_QUALITY_REFIT);
+  // Embree reads up to 16 bytes past the last vertex: one spare vertex.
+  vertices_ = static_cast<float*>(rtcSetNewGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), surface_.vertex_count() + 1));
+  auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry_, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                  3 * sizeof(unsigned), surface_.triangle_count()));
+  if (!vertices_ || !indices) throw std::runtime_error("Embree: cannot allocate the body's buffers");
+  for (size_t t = 0; t < surface_.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k) indices[3 * t + static_cast<size_t>(k)] = surface_.triangle(static_cast<uint32_t>(t))[static_cast<size_t>(k)];
+  upload_vertices();
+  rtcCommitGeometry(geometry_);
+  rtcAttachGeometry(scene_, geometry_);
+  rtcCommitScene(scene_);
+  if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw std::runtime_error("Embree: building the body BVH failed");
+}
+
+TriangleBvh::~TriangleBvh() {
+  if (geometry_) rtcReleaseGeometry(geometry_);
+  if (scene_) rtcReleaseScene(scene_);
+  if (device_) rtcReleaseDevice(device_);
+}
+
+void TriangleBvh::upload_vertices() {
+  const auto positions = surface_.positions();
+  for (size_t v = 0; v < positions.size(); ++v)
+    for (int k = 0; k < 3; ++k) vertices_[3 * v + static_cast<size_t>(k)] = positions[v][k];
+}
+
+void TriangleBvh::update() {
+  upload_vertices();
+  rtcUpdateGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0);
+  rtcCommitGeometry(geometry_);
+  rtcCommitScene(scene_);
+}
+
+bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
+  RTCPointQuery query;
+  query.x = p.x();
+  query.y = p.y();
+  query.z = p.z();
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  QueryState state{&surface_, &hit, false};
+  rtcPointQuery(scene_, &query, &context, visit_triangle, &state);
+  return state.found;
+}
+
+}  // namespace drape::collision

@@ -37,7 +37,7 @@ StrainLimitResult run_passes(const StepContext& c, Kernel&& kernel, AfterPass&& 
         for (size_t s = begin; s < end; ++s) corrections += kernel(s) ? 1u : 0u;
       }
     }
-    after_pass();
+    if (corrections > 0) after_pass();  // nothing changed: nothing to answer
     ++result.passes;
     result.corrections += corrections;
     result.at_pass_limit = corrections > 0;

@@ -24,7 +24,7 @@ struct SceneArgs {
   uint32_t n = 64;
   std::string strain_limit = "velocity";
   float threshold = -1;
-  int passes = 4;
+  int passes = 2;
   std::string fabric = "cotton";
   float time_step = 0;
   double max_time = 12;

@@ -25,7 +25,7 @@ struct ClothSceneOptions {
   Fabric fabric = {};       // default: the "cotton" preset (make_cloth_scene fills it when name is empty)
   StrainLimit strain_limit = StrainLimit::Velocity;
   float strain_threshold = -1;  // < 0: the fabric's
-  int strain_passes = 4;
+  int strain_passes = 2;
   float time_step = 0;          // 0: the stability bound (eq. 4)
 };
 

@@ -1,0 +1,385 @@
+// Landmarks on any standing body (A- or T-pose) in drape's frame: Y up, facing +Z, feet on y = 0.
+//
+// Everything is found from cross-sections (body/slicing.hpp), the way an anthropometrist reads a
+// body scan: the crotch is where the section stops straddling the midline, the armpits are where
+// the torso section suddenly takes in an arm, the neck is the narrowest section between the
+// shoulders and the head, the waist the narrowest torso section between hips and bust, and so on.
+// Limb landmarks use sections perpendicular to the limb's axis, so the same code reads A- and
+// T-poses. Where anatomy gives no section feature (knee, elbow) a standard proportion of the limb
+// is used; docs/bodies.md lists each rule.
+#include <algorithm>
+#include <cmath>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <optional>
+
+#include "body/analysis.hpp"
+#include "body/slicing.hpp"
+#include "drape/body.hpp"
+#include "drape/error.hpp"
+
+namespace drape {
+
+using body::SectionPiece;
+
+std::vector<std::pair<std::string_view, Vec3f>> Landmarks::named() const {
+  return {{"crown", crown},
+          {"neck_base", neck_base},
+          {"neck", neck},
+          {"left_shoulder", left_shoulder},
+          {"right_shoulder", right_shoulder},
+          {"left_armpit", left_armpit},
+          {"right_armpit", right_armpit},
+          {"left_bust", left_bust},
+          {"right_bust", right_bust},
+          {"underbust", underbust},
+          {"waist", waist},
+          {"hip", hip},
+          {"crotch", crotch},
+          {"left_knee", left_knee},
+          {"right_knee", right_knee},
+          {"left_ankle", left_ankle},
+          {"right_ankle", right_ankle},
+          {"left_elbow", left_elbow},
+          {"right_elbow", right_elbow},
+          {"left_wrist", left_wrist},
+          {"right_wrist", right_wrist},
+          {"left_fingertip", left_fingertip},
+          {"right_fingertip", right_fingertip}};
+}
+
+namespace body {
+
+std::optional<SectionPiece> torso_section(const Mesh& mesh, float y) {
+  auto pieces = slice(mesh, horizontal_plane(y));
+  const int i = piece_straddling(pieces, 0.0f);
+  if (i < 0) return std::nullopt;
+  return std::move(pieces[static_cast<size_t>(i)]);
+}
+
+float torso_girth(const Mesh& mesh, float y) {
+  auto s = torso_section(mesh, y);
+  return s ? hull_perimeter(s->points) : 0.0f;
+}
+
+std::optional<SectionPiece> leg_section(const Mesh& mesh, float y, int side) {
+  auto pieces = slice(mesh, horizontal_plane(y));
+  // The leg is the piece on that side nearest the midline (hands hang further out).
+  int best = -1;
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    const float cx = pieces[i].centroid.x() * static_cast<float>(side);
+    if (cx <= 0 || pieces[i].min.x() * static_cast<float>(side) < -0.02f) continue;
+    if (best < 0 || cx < pieces[static_cast<size_t>(best)].centroid.x() * static_cast<float>(side)) best = static_cast<int>(i);
+  }
+  if (best < 0) return std::nullopt;
+  return std::move(pieces[static_cast<size_t>(best)]);
+}
+
+SlicePlane limb_plane(const Vec3f& point, const Vec3f& axis) {
+  const Vec3f n = axis.normalized();
+  Vec3f u = n.cross(Vec3f::UnitZ());
+  if (u.norm() < 1e-3f) u = n.cross(Vec3f::UnitX());
+  return SlicePlane{point, n, u.normalized()};
+}
+
+std::optional<SectionPiece> limb_section(const Mesh& mesh, const Vec3f& point, const Vec3f& axis) {
+  const SlicePlane plane = limb_plane(point, axis);
+  auto pieces = slice(mesh, plane);
+  const int i = nearest_piece(pieces, Vec2f::Zero());
+  if (i < 0) return std::nullopt;
+  return std::move(pieces[static_cast<size_t>(i)]);
+}
+
+float limb_girth(const Mesh& mesh, const Vec3f& point, const Vec3f& axis) {
+  auto s = limb_section(mesh, point, axis);
+  return s ? hull_perimeter(s->points) : 0.0f;
+}
+
+}  // namespace body
+
+namespace {
+
+using namespace body;
+
+[[noreturn]] void fail(const std::string& source, const std::string& what) {
+  throw InputError(source, "not a standing person in A- or T-pose: " + what);
+}
+
+// Arm landmarks on one side (+1 left, -1 right).
+struct ArmLandmarks {
+  Vec3f shoulder, armpit, elbow, wrist, fingertip;
+};
+
+ArmLandmarks find_arm(const Mesh& mesh, int side, float armpit_y, const SectionPiece& below_armpit_torso,
+                      float neck_y, const std::string& source) {
+  const float s = static_cast<float>(side);
+  ArmLandmarks arm{};
+  // Armpit: the top of the gap between torso and arm, just below where they merge.
+  {
+    const float torso_edge = s > 0 ? below_armpit_torso.max.x() : below_armpit_torso.min.x();
+    float edge_z = below_armpit_torso.centroid.y();
+    for (const auto& q : below_armpit_torso.points)
+      if (q.x() == torso_edge) edge_z = q.y();
+    float gap = 0.0f;  // to the arm's inner edge; 0 when the arm is not a separate piece (T-pose)
+    float nearest = 1e9f;
+    for (const auto& piece : slice(mesh, horizontal_plane(armpit_y))) {
+      const float beyond = ((s > 0 ? piece.min.x() : -piece.max.x())) - torso_edge * s;
+      if (beyond > 0 && beyond < nearest) nearest = beyond;
+    }
+    if (nearest < 0.1f) gap = nearest;
+    arm.armpit = Vec3f(torso_edge + 0.5f * gap * s, armpit_y, edge_z);
+  }
+  // Fingertip: the most lateral vertex below the neck.
+  float best = -1;
+  for (const auto& p : mesh.positions) {
+    if (p.y() > neck_y) continue;
+    if (p.x() * s > best) {
+      best = p.x() * s;
+      arm.fingertip = p;
+    }
+  }
+  if (best < std::abs(arm.armpit.x()) + 0.2f) fail(source, "no arm found beyond the armpit");
+
+  // Arm axis: centroids of sections perpendicular to the rough armpit->fingertip line, then a
+  // least-squares line through them.
+  const Vec3f rough_start = arm.armpit + Vec3f(0.0f, 0.03f, 0.0f);
+  Vec3f axis = (arm.fingertip - rough_start).normalized();
+  const float reach = (arm.fingertip - rough_start).norm();
+  std::vector<Vec3f> centres;
+  for (float t = 0.15f; t <= 0.62f; t += 0.04f) {
+    const Vec3f at = rough_start + t * reach * axis;
+    auto sec = limb_section(mesh, at, axis);
+    if (sec) centres.push_back(limb_plane(at, axis).to_world(sec->centroid));
+  }
+  if (centres.size() < 4) fail(source, "cannot follow the arm");
+  Vec3f mean = Vec3f::Zero();
+  for (const auto& c : centres) mean += c;
+  mean /= static_cast<float>(centres.size());
+  Eigen::Matrix3f cov = Eigen::Matrix3f::Zero();
+  for (const auto& c : centres) cov += (c - mean) * (c - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> eig(cov);
+  Vec3f dir = eig.eigenvectors().col(2);
+  if (dir.dot(axis) < 0) dir = -dir;
+  axis = dir;
+  // Axis origin: where the axis passes the armpit height's horizontal level (the shoulder joint
+  // lies a little above it).
+  auto on_axis = [&](float t) { return Vec3f(mean + t * axis); };
+  const float t_tip = (arm.fingertip - mean).dot(axis);
+  const float t_armpit = (arm.armpit - mean).dot(axis);
+
+  // Wrist: the narrowest perpendicular section between 50 % and 80 % of armpit -> fingertip.
+  float wrist_girth = 1e9f, t_wrist = 0;
+  for (float f = 0.5f; f <= 0.8f; f += 0.01f) {
+    const float t = t_armpit + f * (t_tip - t_armpit);
+    const float g = limb_girth(mesh, on_axis(t), axis);
+    if (g > 0 && g < wrist_girth) {
+      wrist_girth = g;
+      t_wrist = t;
+    }
+  }
+  arm.wrist = on_axis(t_wrist);
+
+  // Shoulder point (acromion): the top of the surface straight above the armpit.
+  const Vec3f joint(arm.armpit.x(), on_axis(t_armpit).y(), on_axis(t_armpit).z());
+  float top = -1e9f;
+  for (const auto& p : mesh.positions) {
+    if (std::abs(p.x() - joint.x()) < 0.01f && std::abs(p.z() - joint.z()) < 0.04f && p.y() < neck_y && p.y() > top)
+      top = p.y();
+  }
+  if (top < joint.y()) fail(source, "cannot find the shoulder");
+  arm.shoulder = Vec3f(joint.x(), top, joint.z());
+  // Elbow: 57 % of the way from the shoulder point to the wrist (upper arm : forearm ~ 4 : 3).
+  arm.elbow = arm.shoulder + 0.57f * (arm.wrist - arm.shoulder);
+  arm.elbow = on_axis((arm.elbow - mean).dot(axis));
+  return arm;
+}
+
+}  // namespace
+
+Landmarks find_landmarks(const Mesh& mesh, const std::string& source) {
+  if (mesh.positions.empty() || mesh.triangles.empty()) throw InputError(source, "no mesh");
+  Landmarks lm;
+  const Bounds box = bounds(mesh.positions);
+  const float height = box.max.y();
+  for (const auto& p : mesh.positions)
+    if (p.y() >= height) lm.crown = p;
+
+  // Crotch: scanning down from above the hips, the last height whose section straddles x = 0.
+  float y_straddle = 0.58f * height;
+  if (!torso_section(mesh, y_straddle)) fail(source, "no torso section at hip height");
+  float y_free = y_straddle;
+  while (y_free > 0.25f * height && torso_section(mesh, y_free)) y_free -= 0.005f;
+  if (y_free <= 0.25f * height) fail(source, "no gap between the legs");
+  y_straddle = y_free + 0.005f;
+  for (int i = 0; i < 12; ++i) {
+    const float mid = 0.5f * (y_free + y_straddle);
+    (torso_section(mesh, mid) ? y_straddle : y_free) = mid;
+  }
+  const float crotch_y = y_straddle;
+  {
+    auto s = torso_section(mesh, crotch_y + 0.002f);
+    lm.crotch = Vec3f(0.0f, crotch_y, s ? s->centroid.y() : 0.0f);
+  }
+
+  // Armpits: scanning up from the waist region, the height where the torso section's lateral extent
+  // jumps (an arm joins it). Each side separately.
+  float armpit_y[2] = {0, 0};
+  std::optional<SectionPiece> below[2];
+  {
+    std::optional<SectionPiece> previous = torso_section(mesh, crotch_y + 0.3f * (height - crotch_y));
+    for (float y = crotch_y + 0.3f * (height - crotch_y) + 0.002f; y < 0.92f * height; y += 0.002f) {
+      auto s = torso_section(mesh, y);
+      if (!s || !previous) break;
+      for (int k = 0; k < 2; ++k) {
+        if (armpit_y[k] > 0) continue;
+        const bool left = k == 0;
+        const float jump = left ? s->max.x() - previous->max.x() : previous->min.x() - s->min.x();
+        if (jump > 0.025f) {
+          armpit_y[k] = y - 0.002f;
+          below[k] = previous;
+        }
+      }
+      if (armpit_y[0] > 0 && armpit_y[1] > 0) break;
+      previous = std::move(s);
+    }
+  }
+  if (armpit_y[0] <= 0 || armpit_y[1] <= 0) fail(source, "cannot find the armpits");
+  const float top_armpit = std::max(armpit_y[0], armpit_y[1]);
+
+  // Neck: the narrowest section between the armpits and 90 % of the height.
+  float neck_girth = 1e9f;
+  for (float y = top_armpit + 0.02f; y < 0.9f * height; y += 0.003f) {
+    auto s = torso_section(mesh, y);
+    if (!s) continue;
+    const float g = hull_perimeter(s->points);
+    if (g < neck_girth) {
+      neck_girth = g;
+      lm.neck = Vec3f(s->centroid.x(), y, s->centroid.y());
+    }
+  }
+  if (neck_girth > 1e8f) fail(source, "cannot find the neck");
+  // Neck base: going down from the narrowest neck, where the section has grown by a quarter (the
+  // shoulders begin); the cervicale is the back of the midline there.
+  {
+    float y = lm.neck.y();
+    std::optional<SectionPiece> s;
+    for (; y > top_armpit; y -= 0.003f) {
+      s = torso_section(mesh, y);
+      if (s && hull_perimeter(s->points) > 1.25f * neck_girth) break;
+    }
+    float back_z = s ? s->min.y() : lm.neck.z();
+    if (s)
+      for (const auto& q : s->points)
+        if (std::abs(q.x()) < 0.015f) back_z = std::min(back_z, q.y());
+    lm.neck_base = Vec3f(0.0f, y, back_z);
+  }
+
+  const ArmLandmarks left = find_arm(mesh, +1, armpit_y[0], *below[0], lm.neck.y(), source);
+  const ArmLandmarks right = find_arm(mesh, -1, armpit_y[1], *below[1], lm.neck.y(), source);
+  lm.left_shoulder = left.shoulder;
+  lm.left_armpit = left.armpit;
+  lm.left_elbow = left.elbow;
+  lm.left_wrist = left.wrist;
+  lm.left_fingertip = left.fingertip;
+  lm.right_shoulder = right.shoulder;
+  lm.right_armpit = right.armpit;
+  lm.right_elbow = right.elbow;
+  lm.right_wrist = right.wrist;
+  lm.right_fingertip = right.fingertip;
+
+  // Bust points: going down from the armpits, the most forward point of each half of the chest
+  // until the front has fallen back by 1 cm (under the breast); for a flat chest, the most forward
+  // point within 9 % of the height below the armpits.
+  const float low_armpit = std::min(armpit_y[0], armpit_y[1]);
+  for (int side : {+1, -1}) {
+    const float s = static_cast<float>(side);
+    const float arm_x = std::abs(side > 0 ? lm.left_armpit.x() : lm.right_armpit.x());
+    Vec3f best(0, 0, -1e9f);
+    for (float y = low_armpit - 0.01f; y > low_armpit - 0.09f * height; y -= 0.002f) {
+      auto sec = torso_section(mesh, y);
+      if (!sec) continue;
+      Vec3f front(0, 0, -1e9f);
+      for (const auto& q : sec->points)
+        if (q.x() * s > 0.01f && q.x() * s < arm_x - 0.02f && q.y() > front.z()) front = Vec3f(q.x(), y, q.y());
+      if (front.z() > best.z()) best = front;
+      if (front.z() < best.z() - 0.01f) break;
+    }
+    if (best.z() < -1e8f) fail(source, "cannot find the chest");
+    (side > 0 ? lm.left_bust : lm.right_bust) = best;
+  }
+  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+
+  // Underbust: going down from the bust, the first dip of the front profile (the fold under the
+  // breasts, or where the front stops receding), then 1 cm lower to clear the breast tissue.
+  {
+    float min_front = 1e9f, min_y = -1.0f;
+    for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      if (s->max.y() < min_front) {
+        min_front = s->max.y();
+        min_y = y;
+      } else if (s->max.y() > min_front + 0.002f) {
+        break;
+      }
+    }
+    if (min_y < 0) fail(source, "no torso below the bust");
+    lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
+  }
+
+  // Waist: the narrowest torso section between the crotch and the underbust (upper 60 %).
+  {
+    float best = 1e9f;
+    const float from = crotch_y + 0.4f * (lm.underbust.y() - crotch_y);
+    for (float y = from; y < lm.underbust.y() - 0.01f; y += 0.003f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      const float g = hull_perimeter(s->points);
+      if (g < best) {
+        best = g;
+        lm.waist = Vec3f(0.0f, y, s->max.y());
+      }
+    }
+    if (best > 1e8f) fail(source, "cannot find the waist");
+  }
+  // Hip: the fullest torso section between the crotch and the waist.
+  {
+    float best = 0;
+    for (float y = crotch_y + 0.015f; y < lm.waist.y(); y += 0.003f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      const float g = hull_perimeter(s->points);
+      if (g > best) {
+        best = g;
+        lm.hip = Vec3f(0.0f, y, s->min.y());
+      }
+    }
+    if (best <= 0) fail(source, "cannot find the hips");
+  }
+
+  // Ankles: the narrowest leg section between 3 % and 12 % of the height; knees at 57 % of the way
+  // from ankle to crotch (tibia : femur proportions).
+  for (int side : {+1, -1}) {
+    float best = 1e9f;
+    Vec3f ankle = Vec3f::Zero();
+    for (float y = 0.03f * height; y < 0.12f * height; y += 0.003f) {
+      auto s = leg_section(mesh, y, side);
+      if (!s) continue;
+      const float g = hull_perimeter(s->points);
+      if (g < best) {
+        best = g;
+        ankle = Vec3f(s->centroid.x(), y, s->centroid.y());
+      }
+    }
+    if (best > 1e8f) fail(source, "cannot find the ankles");
+    const float knee_y = ankle.y() + 0.57f * (crotch_y - ankle.y());
+    auto k = leg_section(mesh, knee_y, side);
+    if (!k) fail(source, "cannot find the knees");
+    const Vec3f knee(k->centroid.x(), knee_y, k->centroid.y());
+    (side > 0 ? lm.left_ankle : lm.right_ankle) = ankle;
+    (side > 0 ? lm.left_knee : lm.right_knee) = knee;
+  }
+  return lm;
+}
+
+}  // namespace drape

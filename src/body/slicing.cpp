@@ -1,0 +1,141 @@
+#include "body/slicing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace drape::body {
+
+SlicePlane horizontal_plane(float height) {
+  // normal x u = v: (0,-1,0) x (1,0,0) = (0,0,1).
+  return SlicePlane{Vec3f(0, height, 0), Vec3f(0, -1, 0), Vec3f(1, 0, 0)};
+}
+
+namespace {
+
+struct DisjointSets {
+  std::vector<uint32_t> parent;
+  explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  uint32_t find(uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void unite(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+std::vector<SectionPiece> slice(const Mesh& mesh, const SlicePlane& plane) {
+  const auto& p = mesh.positions;
+  std::vector<float> side(p.size());
+  for (size_t i = 0; i < p.size(); ++i) side[i] = (p[i] - plane.origin).dot(plane.normal);
+
+  // Each crossing edge gives one point, keyed by the edge so that neighbouring triangles share it.
+  std::unordered_map<uint64_t, uint32_t> point_of_edge;
+  std::vector<Vec2f> points;
+  std::vector<std::pair<uint32_t, uint32_t>> links;
+  const Vec3f v_axis = plane.v_axis();
+  auto crossing = [&](uint32_t a, uint32_t b) -> uint32_t {
+    if (a > b) std::swap(a, b);
+    const uint64_t key = (uint64_t{a} << 32) | b;
+    auto [it, fresh] = point_of_edge.try_emplace(key, static_cast<uint32_t>(points.size()));
+    if (fresh) {
+      const float t = side[a] / (side[a] - side[b]);
+      const Vec3f q = p[a] + t * (p[b] - p[a]) - plane.origin;
+      points.emplace_back(q.dot(plane.u_axis), q.dot(v_axis));
+    }
+    return it->second;
+  };
+  for (const Tri& t : mesh.triangles) {
+    uint32_t ends[2];
+    int n = 0;
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = t[e], b = t[(e + 1) % 3];
+      if ((side[a] < 0) != (side[b] < 0) && n < 2) ends[n++] = crossing(a, b);
+    }
+    if (n == 2) links.emplace_back(ends[0], ends[1]);
+  }
+
+  // Connected pieces through the segments.
+  DisjointSets sets(points.size());
+  for (auto [a, b] : links) sets.unite(a, b);
+  std::unordered_map<uint32_t, size_t> piece_of_root;
+  std::vector<SectionPiece> pieces;
+  for (uint32_t i = 0; i < points.size(); ++i) {
+    auto [it, fresh] = piece_of_root.try_emplace(sets.find(i), pieces.size());
+    if (fresh) pieces.emplace_back();
+    pieces[it->second].points.push_back(points[i]);
+  }
+  std::erase_if(pieces, [](const SectionPiece& s) { return s.points.size() < 3; });
+  for (auto& s : pieces) {
+    s.min = s.max = s.points[0];
+    Vec2f sum = Vec2f::Zero();
+    for (const auto& q : s.points) {
+      s.min = s.min.cwiseMin(q);
+      s.max = s.max.cwiseMax(q);
+      sum += q;
+    }
+    s.centroid = sum / static_cast<float>(s.points.size());
+  }
+  // A stable order (by u of the centroid) so results never depend on hash order.
+  std::sort(pieces.begin(), pieces.end(), [](const SectionPiece& a, const SectionPiece& b) {
+    return a.centroid.x() < b.centroid.x() || (a.centroid.x() == b.centroid.x() && a.centroid.y() < b.centroid.y());
+  });
+  return pieces;
+}
+
+float hull_perimeter(std::vector<Vec2f> pts) {
+  if (pts.size() < 2) return 0.0f;
+  // Andrew's monotone chain.
+  std::sort(pts.begin(), pts.end(), [](const Vec2f& a, const Vec2f& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  auto cross = [](const Vec2f& o, const Vec2f& a, const Vec2f& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  std::vector<Vec2f> hull(2 * pts.size());
+  size_t k = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  hull.resize(k - 1);
+  double perimeter = 0;
+  for (size_t i = 0; i < hull.size(); ++i) perimeter += (hull[(i + 1) % hull.size()] - hull[i]).norm();
+  return static_cast<float>(perimeter);
+}
+
+int nearest_piece(const std::vector<SectionPiece>& pieces, const Vec2f& uv) {
+  int best = -1;
+  float best_d = std::numeric_limits<float>::max();
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    for (const auto& q : pieces[i].points) {
+      const float d = (q - uv).squaredNorm();
+      if (d < best_d) {
+        best_d = d;
+        best = static_cast<int>(i);
+      }
+    }
+  }
+  return best;
+}
+
+int piece_straddling(const std::vector<SectionPiece>& pieces, float u) {
+  int best = -1;
+  float best_span = 0;
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    const auto& s = pieces[i];
+    if (s.min.x() < u && s.max.x() > u && s.max.x() - s.min.x() > best_span) {
+      best_span = s.max.x() - s.min.x();
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
+}
+
+}  // namespace drape::body

@@ -88,6 +88,7 @@ struct RenderOptions {
   // scenes (frames of an animation, two simulation methods) at the same size.
   float pixels_per_metre = 0.0f;
   bool floor_shadow = true;
+  bool ambient_occlusion = true;   // darken folds, creases and skin just under a garment's edge
   bool view_labels = true;         // the view's name under each panel
   std::string title;               // optional caption at the top left
   std::optional<Legend> legend;

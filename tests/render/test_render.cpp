@@ -85,6 +85,29 @@ TEST(Render, ClothIsLitFromBothSides) {
   EXPECT_LT(away, facing);  // and darker: the inside of the garment
 }
 
+TEST(Render, AmbientOcclusionDarkensCreasesNotPlanes) {
+  // A flat sheet facing the camera, and a V-shaped fold opening towards it (crease at x = 0).
+  Mesh flat, fold;
+  flat.positions = {{-1, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 1, 0}};
+  flat.triangles = {{0, 1, 2}, {0, 2, 3}};
+  fold.positions = {{-1, 0, 1}, {0, 0, 0}, {0, 1, 0}, {-1, 1, 1}, {1, 0, 1}, {1, 1, 1}};
+  fold.triangles = {{0, 1, 2}, {0, 2, 3}, {1, 4, 5}, {1, 5, 2}};
+  RenderOptions o = plain_options(200, 100);
+  const auto pair = [&](const Mesh& m) {
+    const RenderItem item{&m, Vec3f::Constant(0.6f), {}};
+    o.ambient_occlusion = true;
+    Image with = render_views({item}, o);
+    o.ambient_occlusion = false;
+    return std::make_pair(with, render_views({item}, o));
+  };
+  const auto [flat_ao, flat_plain] = pair(flat);
+  EXPECT_EQ(flat_ao.rgb, flat_plain.rgb);
+  const auto [fold_ao, fold_plain] = pair(fold);
+  // Just beside the crease (the picture's centre column), darker; far out on the wings, unchanged.
+  EXPECT_LT(luminance(fold_ao.pixel(101, 50)) + 0.01f, luminance(fold_plain.pixel(101, 50)));
+  EXPECT_NEAR(luminance(fold_ao.pixel(185, 50)), luminance(fold_plain.pixel(185, 50)), 1e-3f);
+}
+
 TEST(Render, PerVertexColoursAndLegend) {
   const Mesh sphere = uv_sphere(0.5f, Vec3f::Zero(), 32, 16);
   std::vector<float> height;

@@ -7,6 +7,7 @@
 // front, side and back look alike: hemisphere ambient, a key light from the upper left, a fill
 // from the right and a rim light from behind that separates the silhouette from the backdrop.
 // Surfaces seen from behind (the inside of a garment) are lit with the flipped normal and darkened.
+// Screen-space ambient occlusion darkens folds and the skin under a garment's edge.
 // The floor shadow is the scene rendered from below into a height-above-floor map, turned into
 // occlusion (falling off with height) and blurred; backdrop samples look it up where their view ray
 // meets the floor plane.

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   drape::app::add_convert_command(app);
   drape::app::add_render_command(app);
   drape::app::add_scene_command(app);
+  drape::app::add_body_command(app);
+  drape::app::add_measure_command(app);
 
   try {
     app.parse(argc, argv);

@@ -25,7 +25,7 @@ BvhCollider::BvhCollider(const Mesh& body) : surface_(body.positions, body.trian
   const auto start = std::chrono::steady_clock::now();
   bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats_.memory_bytes = surface_.triangle_count() * 64;  // Embree reports no size; ~64 B per triangle node
+  stats_.memory_bytes = surface_.triangle_count() * 64;  // Embree reports no size: about 64 B per triangle
 }
 
 void BvhCollider::set_surface(std::span<const Vec3f> positions, double t) {

@@ -120,7 +120,11 @@ void check_outline(const Panel& panel, const std::string& source) {
       const size_t j = order[ib];
       if ((i + 1) % n == j || (j + 1) % n == i || i == j) continue;  // neighbours share an end point
       if (segments_intersect(poly.points[i], poly.points[(i + 1) % n], poly.points[j], poly.points[(j + 1) % n])) {
-        const Vec2d at = poly.points[i];
+        // Where the two segments cross (their supporting lines; the point of contact when parallel).
+        const Vec2d p0 = poly.points[i], r = poly.points[(i + 1) % n] - p0;
+        const Vec2d q0 = poly.points[j], q = poly.points[(j + 1) % n] - q0;
+        const double denom = cross(r, q);
+        const Vec2d at = std::abs(denom) > 1e-18 ? Vec2d(p0 + cross(q0 - p0, q) / denom * r) : q0;
         throw InputError(source, fmt::format("{}: outline intersects itself (edge {} crosses edge {} near ({:.3f}, {:.3f}) m)",
                                              where, poly.edge[std::min(i, j)], poly.edge[std::max(i, j)], at.x(), at.y()));
       }

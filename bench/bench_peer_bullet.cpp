@@ -16,7 +16,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <vector>
 
@@ -147,7 +146,6 @@ void report(benchmark::State& state, const Result& r, int n) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  setenv("OMP_WAIT_POLICY", "passive", 0);  // see bench_cloth.cpp: idle threads sleep, not spin
   benchmark::Initialize(&argc, argv);
   std::map<int, Result> bullet, drape1, drape2;
   for (int n : {32, 64, 128}) {

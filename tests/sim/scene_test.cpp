@@ -20,7 +20,7 @@ bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
 ClothSceneOptions sphere_scene(StrainLimit limit) {
   ClothSceneOptions o;
   o.obstacle = SceneObstacle::Sphere;
-  o.n = sanitized() ? 20 : 32;
+  o.n = 32;  // also under sanitizers: at n = 20 the plain cloth stretches only 7 % (coarser folds)
   o.fabric = fabric_or_throw("cotton");
   o.strain_limit = limit;
   o.strain_threshold = 0.05f;

@@ -1,6 +1,7 @@
 // `drape convert IN OUT`: mesh files between OBJ, PLY and GLB/glTF, converted to metres and +Y up.
 // The input is validated like `drape info` does; the output is written whole or not at all.
 #include <fmt/format.h>
+
 #include <memory>
 
 #include "commands.hpp"
@@ -27,10 +28,12 @@ void run_convert(const ConvertArgs& args) {
 void add_convert_command(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "convert", "Convert a mesh between OBJ, PLY and GLB/glTF (formats by extension), to metres and +Y up.\n"
-                 "OBJ and PLY hold one mesh: a glTF scene is merged into one, without skin or animation.");
+      "convert",
+      "Convert a mesh between OBJ, PLY and GLB/glTF (formats by extension), to metres and +Y up.\n"
+      "OBJ and PLY hold one mesh: a glTF scene is merged into one, without skin or animation.");
   cmd->add_option("IN", args->input, "Input mesh file")->required();
-  cmd->add_option("OUT", args->output, "Output file (.obj, .ply, .glb or .gltf); written whole or not at all")->required();
+  cmd->add_option("OUT", args->output, "Output file (.obj, .ply, .glb or .gltf); written whole or not at all")
+      ->required();
   add_load_options(*cmd, args->load);
   cmd->callback([args] { run_convert(*args); });
 }

@@ -1,6 +1,7 @@
 // `drape info FILE`: what a mesh file holds (counts, bounds, height, holes, skin, animation), as text or
 // JSON. Loading validates the file: a malformed one is refused with exit status 2.
 #include <fmt/format.h>
+
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -42,7 +43,8 @@ void run_info(const InfoArgs& args) {
     j["up_in"] = args.load.up;
     j["vertices"] = check.vertices;
     j["triangles"] = check.triangles;
-    j["bounds_m"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}}, {"max", {box.max.x(), box.max.y(), box.max.z()}}};
+    j["bounds_m"] = {{"min", {box.min.x(), box.min.y(), box.min.z()}},
+                     {"max", {box.max.x(), box.max.y(), box.max.z()}}};
     j["height_m"] = box.size().y();
     j["boundary_edges"] = check.boundary_edges;
     j["boundary_loops"] = check.boundary_loops;
@@ -56,7 +58,8 @@ void run_info(const InfoArgs& args) {
     for (const Skin& s : scene.skins) j["skins"].push_back({{"name", s.name}, {"joints", s.joints.size()}});
     j["animations"] = nlohmann::json::array();
     for (const Animation& a : scene.animations)
-      j["animations"].push_back({{"name", a.name}, {"channels", a.channels.size()}, {"duration_s", duration(a)}});
+      j["animations"].push_back(
+          {{"name", a.name}, {"channels", a.channels.size()}, {"duration_s", duration(a)}});
     j["morph_targets"] = morph_targets;
     fmt::print("{}\n", j.dump(2));
     return;
@@ -67,16 +70,20 @@ void run_info(const InfoArgs& args) {
   fmt::print("bounds min (m):            {:.4f} {:.4f} {:.4f}\n", box.min.x(), box.min.y(), box.min.z());
   fmt::print("bounds max (m):            {:.4f} {:.4f} {:.4f}\n", box.max.x(), box.max.y(), box.max.z());
   fmt::print("height (m):                {:.4f}\n", box.size().y());
-  fmt::print("boundary loops:            {} ({} boundary edges)\n", check.boundary_loops, check.boundary_edges);
+  fmt::print("boundary loops:            {} ({} boundary edges)\n", check.boundary_loops,
+             check.boundary_edges);
   fmt::print("non-manifold edges:        {}\n", check.non_manifold_edges);
   fmt::print("degenerate faces dropped:  {}\n", check.degenerate_faces_removed);
   fmt::print("faces triangulated:        {}\n", check.non_triangle_faces_triangulated);
-  fmt::print("meshes:                    {} on nodes: {}\n", scene.meshes.size(), fmt::join(mesh_nodes, ", "));
+  fmt::print("meshes:                    {} on nodes: {}\n", scene.meshes.size(),
+             fmt::join(mesh_nodes, ", "));
   if (scene.skins.empty()) fmt::print("skin:                      none\n");
-  for (const Skin& s : scene.skins) fmt::print("skin:                      '{}' with {} joints\n", s.name, s.joints.size());
+  for (const Skin& s : scene.skins)
+    fmt::print("skin:                      '{}' with {} joints\n", s.name, s.joints.size());
   if (scene.animations.empty()) fmt::print("animations:                none\n");
   for (const Animation& a : scene.animations)
-    fmt::print("animation:                 '{}', {} channels, {:.3f} s\n", a.name, a.channels.size(), duration(a));
+    fmt::print("animation:                 '{}', {} channels, {:.3f} s\n", a.name, a.channels.size(),
+               duration(a));
   fmt::print("morph targets:             {}\n", morph_targets);
 }
 
@@ -85,8 +92,9 @@ void run_info(const InfoArgs& args) {
 void add_info_command(CLI::App& app) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "info", "Print counts, bounds, height, holes, non-manifold edges, skin and animation of a mesh file\n"
-              "(.obj, .ply, .glb, .gltf). Lengths are reported in metres after --units/--up conversion.");
+      "info",
+      "Print counts, bounds, height, holes, non-manifold edges, skin and animation of a mesh file\n"
+      "(.obj, .ply, .glb, .gltf). Lengths are reported in metres after --units/--up conversion.");
   cmd->add_option("FILE", args->file, "Mesh file")->required();
   cmd->add_flag("--json", args->json, "Print JSON instead of text");
   add_load_options(*cmd, args->load);

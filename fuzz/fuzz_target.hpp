@@ -4,8 +4,8 @@
 // input parses, writing the scene back and parsing that must succeed too: the writers only produce
 // what the readers accept.
 #include <cstdint>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 
 #include "drape/error.hpp"
 #include "drape/io.hpp"
@@ -22,7 +22,8 @@ inline int parse_and_round_trip(const uint8_t* data, size_t size, MeshFormat for
   try {
     const Mesh merged = merge_scene(scene);
     const std::string obj = encode_obj(merged);
-    parse_scene({reinterpret_cast<const unsigned char*>(obj.data()), obj.size()}, MeshFormat::Obj, "again.obj");
+    parse_scene({reinterpret_cast<const unsigned char*>(obj.data()), obj.size()}, MeshFormat::Obj,
+                "again.obj");
     parse_scene(encode_ply(merged), MeshFormat::Ply, "again.ply");
     parse_scene(encode_glb(scene), MeshFormat::Glb, "again.glb");
   } catch (const InputError& e) {

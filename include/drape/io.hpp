@@ -50,12 +50,14 @@ MeshFormat mesh_format_of(const std::filesystem::path& path);
 // Reads a whole scene: OBJ and PLY give one mesh on one node named after the file's stem; glTF keeps its
 // nodes, hierarchy, skins, animations and morph targets. The format comes from the file's magic bytes
 // where it has one (GLB, PLY), else from the extension. `check`, when given, receives what was found.
-Scene read_scene(const std::filesystem::path& path, const LoadOptions& options = {}, MeshCheck* check = nullptr);
+Scene read_scene(const std::filesystem::path& path, const LoadOptions& options = {},
+                 MeshCheck* check = nullptr);
 
 // Reads all meshes of a file merged into one, in world space (node transforms applied; skinned meshes
 // in their bind pose). Vertex i of an OBJ/PLY file stays vertex i (OBJ vertices with several UVs or
 // normals get extra copies appended after the file's vertices).
-Mesh read_mesh(const std::filesystem::path& path, const LoadOptions& options = {}, MeshCheck* check = nullptr);
+Mesh read_mesh(const std::filesystem::path& path, const LoadOptions& options = {},
+               MeshCheck* check = nullptr);
 
 // Same as read_scene, from bytes in memory; `source` names the input in error messages, `format` says
 // how to parse (magic bytes still win). External glTF buffers are looked up next to `source`.
@@ -81,6 +83,7 @@ enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
 std::vector<unsigned char> encode_glb(const Scene& scene);
 std::string encode_gltf(const Scene& scene);  // JSON with the buffer as a data: URI
 std::string encode_obj(const Mesh& mesh);
-std::vector<unsigned char> encode_ply(const Mesh& mesh, PlyEncoding encoding = PlyEncoding::BinaryLittleEndian);
+std::vector<unsigned char> encode_ply(const Mesh& mesh,
+                                      PlyEncoding encoding = PlyEncoding::BinaryLittleEndian);
 
 }  // namespace drape

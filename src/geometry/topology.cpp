@@ -54,7 +54,8 @@ bool ear_clip(const std::vector<Vec3f>& positions, std::span<const uint32_t> cor
   while (ring.size() > 3) {
     bool clipped = false;
     for (size_t i = 0; i < ring.size() && !clipped; ++i) {
-      const size_t a = ring[(i + ring.size() - 1) % ring.size()], b = ring[i], c = ring[(i + 1) % ring.size()];
+      const size_t a = ring[(i + ring.size() - 1) % ring.size()], b = ring[i],
+                   c = ring[(i + 1) % ring.size()];
       if (cross2(p2[a], p2[b], p2[c]) <= 0.0f) continue;  // reflex corner
       bool empty = true;
       for (size_t k : ring)

@@ -19,7 +19,9 @@ void change_frame(Scene& scene, float scale, const Eigen::Matrix3f& axis_map) {
   const Eigen::Matrix3f& r = axis_map;
   const Eigen::Matrix3f abs_r = r.cwiseAbs();  // permutes per-axis scales
   const Eigen::Quaternionf qr(r);
-  const auto rotate = [&](const Eigen::Quaternionf& q) { return Eigen::Quaternionf(qr * q * qr.conjugate()); };
+  const auto rotate = [&](const Eigen::Quaternionf& q) {
+    return Eigen::Quaternionf(qr * q * qr.conjugate());
+  };
 
   // Mesh data: p -> s R p; directions -> R n.
   for (Mesh& mesh : scene.meshes) {
@@ -51,7 +53,8 @@ void change_frame(Scene& scene, float scale, const Eigen::Matrix3f& axis_map) {
       if (channel.path == AnimationPath::Translation || channel.path == AnimationPath::Scale) {
         for (size_t i = 0; i + 3 <= v.size(); i += 3) {
           const Vec3f x(v[i], v[i + 1], v[i + 2]);
-          const Vec3f y = channel.path == AnimationPath::Translation ? Vec3f(scale * (r * x)) : Vec3f(abs_r * x);
+          const Vec3f y =
+              channel.path == AnimationPath::Translation ? Vec3f(scale * (r * x)) : Vec3f(abs_r * x);
           v[i] = y.x(), v[i + 1] = y.y(), v[i + 2] = y.z();
         }
       } else if (channel.path == AnimationPath::Rotation) {

@@ -10,6 +10,7 @@
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
 #define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <fmt/format.h>
 #include <tiny_gltf.h>
 
 #include <Eigen/Geometry>
@@ -17,7 +18,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fmt/format.h>
 #include <fstream>
 #include <sstream>
 
@@ -28,7 +28,8 @@ namespace drape::io {
 namespace {
 
 // Images are not needed (drape renders its own materials): accept them undecoded.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                void*) {
   return true;
 }
 
@@ -38,7 +39,9 @@ bool regular_file_exists(const std::string& path, void*) {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
-std::string keep_path(const std::string& path, void*) { return path; }
+std::string keep_path(const std::string& path, void*) {
+  return path;
+}
 bool read_regular_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
@@ -99,12 +102,18 @@ class GltfReader {
 
 const char* type_name(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "other";
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "other";
   }
 }
 
@@ -125,8 +134,9 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
   v.component_type = a.componentType;
   v.normalized = a.normalized;
   v.count = a.count;
-  const size_t element = v.components * static_cast<size_t>(tinygltf::GetComponentSizeInBytes(
-                                            static_cast<uint32_t>(a.componentType)));
+  const size_t element =
+      v.components *
+      static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType)));
   v.stride = element;
   if (a.bufferView < 0) return v;  // zeros, per the spec
   if (static_cast<size_t>(a.bufferView) >= model_.bufferViews.size())
@@ -136,7 +146,8 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
     fail(fmt::format("{}: buffer {} does not exist", where, bv.buffer));
   const std::vector<unsigned char>& buffer = model_.buffers[static_cast<size_t>(bv.buffer)].data;
   if (bv.byteStride != 0) {
-    if (bv.byteStride < element) fail(fmt::format("{}: byte stride {} is smaller than an element", where, bv.byteStride));
+    if (bv.byteStride < element)
+      fail(fmt::format("{}: byte stride {} is smaller than an element", where, bv.byteStride));
     v.stride = bv.byteStride;
   }
   // Everything read must lie inside the view, and the view inside its buffer (no overflow: count is
@@ -159,8 +170,12 @@ std::vector<float> GltfReader::floats(const AccessorView& v) const {
     for (size_t c = 0; c < v.components; ++c) {
       float x = 0;
       switch (v.component_type) {
-        case TINYGLTF_COMPONENT_TYPE_FLOAT: std::memcpy(&x, e + 4 * c, 4); break;
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: x = e[c] / (v.normalized ? 255.0f : 1.0f); break;
+        case TINYGLTF_COMPONENT_TYPE_FLOAT:
+          std::memcpy(&x, e + 4 * c, 4);
+          break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          x = e[c] / (v.normalized ? 255.0f : 1.0f);
+          break;
         case TINYGLTF_COMPONENT_TYPE_BYTE: {
           const auto s = static_cast<int8_t>(e[c]);
           x = v.normalized ? std::max(s / 127.0f, -1.0f) : s;
@@ -178,7 +193,8 @@ std::vector<float> GltfReader::floats(const AccessorView& v) const {
           x = v.normalized ? std::max(s / 32767.0f, -1.0f) : s;
           break;
         }
-        default: fail("unsupported float component type");
+        default:
+          fail("unsupported float component type");
       }
       out[i * v.components + c] = x;
     }
@@ -194,15 +210,20 @@ std::vector<uint32_t> GltfReader::uints(const AccessorView& v) const {
     for (size_t c = 0; c < v.components; ++c) {
       uint32_t x = 0;
       switch (v.component_type) {
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: x = e[c]; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+          x = e[c];
+          break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
           uint16_t s;
           std::memcpy(&s, e + 2 * c, 2);
           x = s;
           break;
         }
-        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: std::memcpy(&x, e + 4 * c, 4); break;
-        default: fail("unsupported integer component type");
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+          std::memcpy(&x, e + 4 * c, 4);
+          break;
+        default:
+          fail("unsupported integer component type");
       }
       out[i * v.components + c] = x;
     }
@@ -222,9 +243,12 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
   const tinygltf::Mesh& gm = model_.meshes[index];
   Mesh mesh;
   mesh.name = gm.name;
-  const auto has = [&](const tinygltf::Primitive& p, const char* name) { return p.attributes.count(name) > 0; };
+  const auto has = [&](const tinygltf::Primitive& p, const char* name) {
+    return p.attributes.count(name) > 0;
+  };
   const auto every = [&](const char* name) {
-    return std::all_of(gm.primitives.begin(), gm.primitives.end(), [&](const auto& p) { return has(p, name); });
+    return std::all_of(gm.primitives.begin(), gm.primitives.end(),
+                       [&](const auto& p) { return has(p, name); });
   };
   const bool normals = every("NORMAL"), uvs = every("TEXCOORD_0"), colors = every("COLOR_0");
   const bool skinned = every("JOINTS_0") && every("WEIGHTS_0");
@@ -236,10 +260,12 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
     const tinygltf::Primitive& prim = gm.primitives[pi];
     const std::string what = fmt::format("{} primitive {}", element_name("mesh", index, gm.name), pi);
     const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
-    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN)
       fail(fmt::format("{}: mode {} is not triangles (points and lines are not meshes)", what, mode));
     if (!has(prim, "POSITION")) fail(what + " has no POSITION attribute");
-    const auto attribute = [&](const char* name, std::initializer_list<int> types, std::initializer_list<int> comps) {
+    const auto attribute = [&](const char* name, std::initializer_list<int> types,
+                               std::initializer_list<int> comps) {
       const AccessorView v = view(prim.attributes.at(name), what + " " + name, types, comps);
       return v;
     };
@@ -247,7 +273,8 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
     const size_t n = pos.count;
     const auto offset = static_cast<uint32_t>(mesh.positions.size());
     const auto require_count = [&](const AccessorView& v, const char* name) {
-      if (v.count != n) fail(fmt::format("{}: {} has {} elements but POSITION has {}", what, name, v.count, n));
+      if (v.count != n)
+        fail(fmt::format("{}: {} has {} elements but POSITION has {}", what, name, v.count, n));
     };
     const std::vector<float> p = floats(pos);
     for (size_t i = 0; i < n; ++i) mesh.positions.emplace_back(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
@@ -264,7 +291,8 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
       for (size_t i = 0; i < n; ++i) mesh.uvs.emplace_back(f[2 * i], f[2 * i + 1]);
     }
     if (colors) {
-      const AccessorView v = attribute("COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {kFloat, kUByte, kUShort});
+      const AccessorView v =
+          attribute("COLOR_0", {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4}, {kFloat, kUByte, kUShort});
       require_count(v, "COLOR_0");
       const std::vector<float> f = floats(v);
       for (size_t i = 0; i < n; ++i)
@@ -286,7 +314,8 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
     }
     // Morph targets: every primitive must have the same number.
     if (prim.targets.size() != target_count)
-      fail(fmt::format("{} has {} morph targets, primitive 0 has {}", what, prim.targets.size(), target_count));
+      fail(fmt::format("{} has {} morph targets, primitive 0 has {}", what, prim.targets.size(),
+                       target_count));
     for (size_t t = 0; t < target_count; ++t) {
       MorphTarget& target = mesh.morph_targets[t];
       const auto& attrs = prim.targets[t];
@@ -309,25 +338,33 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
     // Indices (or 0..n-1), as triangles.
     std::vector<uint32_t> idx;
     if (prim.indices >= 0) {
-      const AccessorView v = view(prim.indices, what + " indices", {TINYGLTF_TYPE_SCALAR}, {kUByte, kUShort, kUInt});
+      const AccessorView v =
+          view(prim.indices, what + " indices", {TINYGLTF_TYPE_SCALAR}, {kUByte, kUShort, kUInt});
       idx = uints(v);
     } else {
       idx.resize(n);
       for (size_t i = 0; i < n; ++i) idx[i] = static_cast<uint32_t>(i);
     }
     for (size_t i = 0; i < idx.size(); ++i)
-      if (idx[i] >= n) fail(fmt::format("{}: index {} is {} but there are only {} vertices", what, i, idx[i], n));
-    const auto tri = [&](uint32_t a, uint32_t b, uint32_t c) { mesh.triangles.push_back({a + offset, b + offset, c + offset}); };
+      if (idx[i] >= n)
+        fail(fmt::format("{}: index {} is {} but there are only {} vertices", what, i, idx[i], n));
+    const auto tri = [&](uint32_t a, uint32_t b, uint32_t c) {
+      mesh.triangles.push_back({a + offset, b + offset, c + offset});
+    };
     if (mode == TINYGLTF_MODE_TRIANGLES) {
-      if (idx.size() % 3 != 0) fail(fmt::format("{}: {} indices is not a whole number of triangles", what, idx.size()));
+      if (idx.size() % 3 != 0)
+        fail(fmt::format("{}: {} indices is not a whole number of triangles", what, idx.size()));
       for (size_t i = 0; i + 2 < idx.size(); i += 3) tri(idx[i], idx[i + 1], idx[i + 2]);
     } else {
       if (idx.size() < 3) fail(what + ": fewer than 3 indices");
       check.non_triangle_faces_triangulated += 1;
       for (size_t i = 2; i < idx.size(); ++i) {
-        if (mode == TINYGLTF_MODE_TRIANGLE_FAN) tri(idx[0], idx[i - 1], idx[i]);
-        else if (i % 2 == 0) tri(idx[i - 2], idx[i - 1], idx[i]);
-        else tri(idx[i - 1], idx[i - 2], idx[i]);
+        if (mode == TINYGLTF_MODE_TRIANGLE_FAN)
+          tri(idx[0], idx[i - 1], idx[i]);
+        else if (i % 2 == 0)
+          tri(idx[i - 2], idx[i - 1], idx[i]);
+        else
+          tri(idx[i - 1], idx[i - 2], idx[i]);
       }
     }
   }
@@ -337,7 +374,8 @@ Mesh GltfReader::read_mesh(size_t index, MeshCheck& check) const {
   if (gm.extras.Has("targetNames") && gm.extras.Get("targetNames").IsArray()) {
     const tinygltf::Value& names = gm.extras.Get("targetNames");
     for (size_t t = 0; t < target_count && t < names.ArrayLen(); ++t)
-      if (names.Get(static_cast<int>(t)).IsString()) mesh.morph_targets[t].name = names.Get(static_cast<int>(t)).Get<std::string>();
+      if (names.Get(static_cast<int>(t)).IsString())
+        mesh.morph_targets[t].name = names.Get(static_cast<int>(t)).Get<std::string>();
   }
   if (!gm.weights.empty() && gm.weights.size() != target_count)
     fail(fmt::format("{} has {} default weights for {} morph targets", element_name("mesh", index, gm.name),
@@ -358,8 +396,10 @@ void GltfReader::read_nodes(Scene& scene) const {
     Node& node = scene.nodes[i];
     const std::string what = element_name("node", i, gn.name);
     node.name = gn.name;
-    if (gn.mesh >= 0 && static_cast<size_t>(gn.mesh) >= model_.meshes.size()) fail(fmt::format("{}: mesh {} does not exist", what, gn.mesh));
-    if (gn.skin >= 0 && static_cast<size_t>(gn.skin) >= model_.skins.size()) fail(fmt::format("{}: skin {} does not exist", what, gn.skin));
+    if (gn.mesh >= 0 && static_cast<size_t>(gn.mesh) >= model_.meshes.size())
+      fail(fmt::format("{}: mesh {} does not exist", what, gn.mesh));
+    if (gn.skin >= 0 && static_cast<size_t>(gn.skin) >= model_.skins.size())
+      fail(fmt::format("{}: skin {} does not exist", what, gn.skin));
     node.mesh = gn.mesh < 0 ? -1 : gn.mesh;
     node.skin = gn.skin < 0 || gn.mesh < 0 ? -1 : gn.skin;
     const auto finite = [](const std::vector<double>& v) {
@@ -376,32 +416,39 @@ void GltfReader::read_nodes(Scene& scene) const {
       if ((scale.array() == 0.0f).any()) fail(what + ": matrix has a zero scale");
       node.translation = m.topRightCorner<3, 1>();
       node.scale = scale;
-      node.rotation = Eigen::Quaternionf(Eigen::Matrix3f(linear * scale.cwiseInverse().asDiagonal())).normalized();
+      node.rotation =
+          Eigen::Quaternionf(Eigen::Matrix3f(linear * scale.cwiseInverse().asDiagonal())).normalized();
     } else {
       if (!gn.translation.empty()) {
-        if (gn.translation.size() != 3 || !finite(gn.translation)) fail(what + ": translation must be 3 finite numbers");
+        if (gn.translation.size() != 3 || !finite(gn.translation))
+          fail(what + ": translation must be 3 finite numbers");
         node.translation = Vec3f(static_cast<float>(gn.translation[0]), static_cast<float>(gn.translation[1]),
                                  static_cast<float>(gn.translation[2]));
       }
       if (!gn.rotation.empty()) {
-        if (gn.rotation.size() != 4 || !finite(gn.rotation)) fail(what + ": rotation must be 4 finite numbers");
-        node.rotation = Eigen::Quaternionf(static_cast<float>(gn.rotation[3]), static_cast<float>(gn.rotation[0]),
-                                           static_cast<float>(gn.rotation[1]), static_cast<float>(gn.rotation[2]));
+        if (gn.rotation.size() != 4 || !finite(gn.rotation))
+          fail(what + ": rotation must be 4 finite numbers");
+        node.rotation =
+            Eigen::Quaternionf(static_cast<float>(gn.rotation[3]), static_cast<float>(gn.rotation[0]),
+                               static_cast<float>(gn.rotation[1]), static_cast<float>(gn.rotation[2]));
         if (node.rotation.norm() == 0.0f) fail(what + ": rotation is a zero quaternion");
         node.rotation.normalize();
       }
       if (!gn.scale.empty()) {
         if (gn.scale.size() != 3 || !finite(gn.scale)) fail(what + ": scale must be 3 finite numbers");
-        node.scale = Vec3f(static_cast<float>(gn.scale[0]), static_cast<float>(gn.scale[1]), static_cast<float>(gn.scale[2]));
+        node.scale = Vec3f(static_cast<float>(gn.scale[0]), static_cast<float>(gn.scale[1]),
+                           static_cast<float>(gn.scale[2]));
       }
     }
   }
   // Parents from children lists: each node at most one parent, no cycles.
   for (size_t i = 0; i < count; ++i)
     for (int child : model_.nodes[i].children) {
-      if (child < 0 || static_cast<size_t>(child) >= count) fail(fmt::format("node {}: child {} does not exist", i, child));
+      if (child < 0 || static_cast<size_t>(child) >= count)
+        fail(fmt::format("node {}: child {} does not exist", i, child));
       Node& c = scene.nodes[static_cast<size_t>(child)];
-      if (c.parent >= 0 || static_cast<size_t>(child) == i) fail(fmt::format("node {} has more than one parent", child));
+      if (c.parent >= 0 || static_cast<size_t>(child) == i)
+        fail(fmt::format("node {} has more than one parent", child));
       c.parent = static_cast<int>(i);
     }
   for (size_t i = 0; i < count; ++i) {
@@ -421,7 +468,8 @@ void GltfReader::read_skins(Scene& scene) const {
     skin.name = gs.name;
     if (gs.joints.empty()) fail(what + " has no joints");
     for (int j : gs.joints) {
-      if (j < 0 || static_cast<size_t>(j) >= scene.nodes.size()) fail(fmt::format("{}: joint node {} does not exist", what, j));
+      if (j < 0 || static_cast<size_t>(j) >= scene.nodes.size())
+        fail(fmt::format("{}: joint node {} does not exist", what, j));
       skin.joints.push_back(j);
     }
     if (gs.skeleton >= 0 && static_cast<size_t>(gs.skeleton) >= scene.nodes.size())
@@ -429,13 +477,16 @@ void GltfReader::read_skins(Scene& scene) const {
     skin.skeleton = gs.skeleton;
     skin.inverse_bind_matrices.assign(skin.joints.size(), Mat4f::Identity());
     if (gs.inverseBindMatrices >= 0) {
-      const AccessorView v = view(gs.inverseBindMatrices, what + " inverse bind matrices", {TINYGLTF_TYPE_MAT4}, {kFloat});
+      const AccessorView v =
+          view(gs.inverseBindMatrices, what + " inverse bind matrices", {TINYGLTF_TYPE_MAT4}, {kFloat});
       if (v.count < skin.joints.size())
         fail(fmt::format("{}: {} inverse bind matrices for {} joints", what, v.count, skin.joints.size()));
       const std::vector<float> f = floats(v);
       for (size_t j = 0; j < skin.joints.size(); ++j) {
-        for (int k = 0; k < 16; ++k) skin.inverse_bind_matrices[j](k % 4, k / 4) = f[16 * j + static_cast<size_t>(k)];
-        if (!skin.inverse_bind_matrices[j].allFinite()) fail(fmt::format("{}: inverse bind matrix {} is not finite", what, j));
+        for (int k = 0; k < 16; ++k)
+          skin.inverse_bind_matrices[j](k % 4, k / 4) = f[16 * j + static_cast<size_t>(k)];
+        if (!skin.inverse_bind_matrices[j].allFinite())
+          fail(fmt::format("{}: inverse bind matrix {} is not finite", what, j));
       }
     }
     scene.skins.push_back(std::move(skin));
@@ -464,32 +515,43 @@ void GltfReader::read_animations(Scene& scene) const {
       const tinygltf::AnimationChannel& gc = ga.channels[c];
       const std::string what = fmt::format("{} channel {}", element_name("animation", a, ga.name), c);
       if (gc.target_node < 0) continue;  // allowed by the spec (an extension may target something else)
-      if (static_cast<size_t>(gc.target_node) >= scene.nodes.size()) fail(fmt::format("{}: node {} does not exist", what, gc.target_node));
-      if (gc.sampler < 0 || static_cast<size_t>(gc.sampler) >= ga.samplers.size()) fail(fmt::format("{}: sampler {} does not exist", what, gc.sampler));
+      if (static_cast<size_t>(gc.target_node) >= scene.nodes.size())
+        fail(fmt::format("{}: node {} does not exist", what, gc.target_node));
+      if (gc.sampler < 0 || static_cast<size_t>(gc.sampler) >= ga.samplers.size())
+        fail(fmt::format("{}: sampler {} does not exist", what, gc.sampler));
       const tinygltf::AnimationSampler& gs = ga.samplers[static_cast<size_t>(gc.sampler)];
       AnimationChannel channel;
       channel.node = gc.target_node;
       size_t width = 0;
       int type = TINYGLTF_TYPE_VEC3;
       std::initializer_list<int> comps = {kFloat};
-      if (gc.target_path == "translation") channel.path = AnimationPath::Translation, width = 3;
-      else if (gc.target_path == "scale") channel.path = AnimationPath::Scale, width = 3;
-      else if (gc.target_path == "rotation") channel.path = AnimationPath::Rotation, width = 4, type = TINYGLTF_TYPE_VEC4;
+      if (gc.target_path == "translation")
+        channel.path = AnimationPath::Translation, width = 3;
+      else if (gc.target_path == "scale")
+        channel.path = AnimationPath::Scale, width = 3;
+      else if (gc.target_path == "rotation")
+        channel.path = AnimationPath::Rotation, width = 4, type = TINYGLTF_TYPE_VEC4;
       else if (gc.target_path == "weights") {
         channel.path = AnimationPath::Weights, type = TINYGLTF_TYPE_SCALAR;
         const int mesh = scene.nodes[static_cast<size_t>(gc.target_node)].mesh;
         if (mesh < 0) fail(what + ": animates morph weights of a node without a mesh");
         width = scene.meshes[static_cast<size_t>(mesh)].morph_targets.size();
         if (width == 0) fail(what + ": animates morph weights of a mesh without morph targets");
-      } else fail(fmt::format("{}: unknown path '{}'", what, printable(gc.target_path)));
-      if (gs.interpolation == "LINEAR") channel.interpolation = Interpolation::Linear;
-      else if (gs.interpolation == "STEP") channel.interpolation = Interpolation::Step;
-      else if (gs.interpolation == "CUBICSPLINE") channel.interpolation = Interpolation::CubicSpline;
-      else fail(fmt::format("{}: unknown interpolation '{}'", what, printable(gs.interpolation)));
+      } else
+        fail(fmt::format("{}: unknown path '{}'", what, printable(gc.target_path)));
+      if (gs.interpolation == "LINEAR")
+        channel.interpolation = Interpolation::Linear;
+      else if (gs.interpolation == "STEP")
+        channel.interpolation = Interpolation::Step;
+      else if (gs.interpolation == "CUBICSPLINE")
+        channel.interpolation = Interpolation::CubicSpline;
+      else
+        fail(fmt::format("{}: unknown interpolation '{}'", what, printable(gs.interpolation)));
       const AccessorView in = view(gs.input, what + " input", {TINYGLTF_TYPE_SCALAR}, {kFloat});
       const AccessorView out = view(gs.output, what + " output", {type},
-                                    channel.path == AnimationPath::Rotation ? std::initializer_list<int>{kFloat, kByte, kShort, kUByte, kUShort}
-                                                                             : comps);
+                                    channel.path == AnimationPath::Rotation
+                                        ? std::initializer_list<int>{kFloat, kByte, kShort, kUByte, kUShort}
+                                        : comps);
       channel.times = floats(in);
       channel.values = floats(out);
       for (size_t k = 0; k < channel.times.size(); ++k)
@@ -497,8 +559,8 @@ void GltfReader::read_animations(Scene& scene) const {
           fail(fmt::format("{}: key times must be finite and increasing (key {})", what, k));
       const size_t per_key = width * (channel.interpolation == Interpolation::CubicSpline ? 3 : 1);
       if (channel.values.size() != channel.times.size() * per_key)
-        fail(fmt::format("{}: {} output values for {} keys (expected {} per key)", what, channel.values.size(),
-                         channel.times.size(), per_key));
+        fail(fmt::format("{}: {} output values for {} keys (expected {} per key)", what,
+                         channel.values.size(), channel.times.size(), per_key));
       for (float x : channel.values)
         if (!std::isfinite(x)) fail(what + ": non-finite output value");
       animation.channels.push_back(std::move(channel));
@@ -530,10 +592,14 @@ Scene parse_gltf(std::span<const unsigned char> bytes, bool binary, const std::s
       std::memcpy(&v, bytes.data() + at, 4);
       return v;
     };
-    if (bytes.size() < 20) throw InputError(source, fmt::format("truncated GLB: {} bytes, not even a header", bytes.size()));
-    if (u32(4) != 2) throw InputError(source, fmt::format("GLB container version {} is not supported (drape reads 2)", u32(4)));
+    if (bytes.size() < 20)
+      throw InputError(source, fmt::format("truncated GLB: {} bytes, not even a header", bytes.size()));
+    if (u32(4) != 2)
+      throw InputError(source,
+                       fmt::format("GLB container version {} is not supported (drape reads 2)", u32(4)));
     if (u32(8) != bytes.size())
-      throw InputError(source, fmt::format("GLB header says {} bytes but the file has {} (truncated?)", u32(8), bytes.size()));
+      throw InputError(source, fmt::format("GLB header says {} bytes but the file has {} (truncated?)",
+                                           u32(8), bytes.size()));
     if (u32(16) != 0x4E4F534Au) throw InputError(source, "GLB does not start with a JSON chunk");
     if (u32(12) > bytes.size() - 20) throw InputError(source, "GLB JSON chunk runs past the end of the file");
   }
@@ -543,12 +609,14 @@ Scene parse_gltf(std::span<const unsigned char> bytes, bool binary, const std::s
   tinygltf::Model model;
   std::string err, warn;
   const auto size = static_cast<unsigned int>(bytes.size());
-  const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size, base_dir)
-                         : loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
-                                                      size, base_dir);
+  const bool ok = binary
+                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size, base_dir)
+                      : loader.LoadASCIIFromString(
+                            &model, &err, &warn, reinterpret_cast<const char*>(bytes.data()), size, base_dir);
   if (!ok) throw InputError(source, one_line(err.empty() ? "not a valid glTF file" : err));
   if (model.asset.version.rfind("2.", 0) != 0)
-    throw InputError(source, fmt::format("glTF version '{}' is not supported (drape reads 2.0)", printable(model.asset.version)));
+    throw InputError(source, fmt::format("glTF version '{}' is not supported (drape reads 2.0)",
+                                         printable(model.asset.version)));
   return GltfReader(model, source).read(check);
 }
 
@@ -587,8 +655,10 @@ class GltfWriter {
   // An accessor over tightly packed data; min/max are written when `bounds` is set.
   int accessor(const void* data, size_t count, int type, int component_type, int target, bool bounds = false,
                bool normalized = false) {
-    const size_t components = static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(type)));
-    const size_t size = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(component_type)));
+    const size_t components =
+        static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(type)));
+    const size_t size =
+        static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(component_type)));
     tinygltf::Accessor a;
     a.bufferView = view(data, count * components * size, target);
     a.byteOffset = 0;
@@ -670,9 +740,11 @@ int GltfWriter::add_mesh(const Mesh& mesh) {
     }
     if (max_joint < 256) {
       std::vector<uint8_t> j8(j.begin(), j.end());
-      prim.attributes["JOINTS_0"] = accessor(j8.data(), n, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, kArrayBuffer);
+      prim.attributes["JOINTS_0"] =
+          accessor(j8.data(), n, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, kArrayBuffer);
     } else {
-      prim.attributes["JOINTS_0"] = accessor(j.data(), n, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, kArrayBuffer);
+      prim.attributes["JOINTS_0"] =
+          accessor(j.data(), n, TINYGLTF_TYPE_VEC4, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, kArrayBuffer);
     }
     prim.attributes["WEIGHTS_0"] = accessor(w.data(), n, TINYGLTF_TYPE_VEC4, kFloat, kArrayBuffer);
   }
@@ -695,9 +767,11 @@ int GltfWriter::add_mesh(const Mesh& mesh) {
   if (!idx.empty()) {
     if (n <= 65535) {
       std::vector<uint16_t> i16(idx.begin(), idx.end());
-      prim.indices = accessor(i16.data(), i16.size(), TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, kElementBuffer);
+      prim.indices = accessor(i16.data(), i16.size(), TINYGLTF_TYPE_SCALAR,
+                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, kElementBuffer);
     } else {
-      prim.indices = accessor(idx.data(), idx.size(), TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, kElementBuffer);
+      prim.indices = accessor(idx.data(), idx.size(), TINYGLTF_TYPE_SCALAR,
+                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, kElementBuffer);
     }
   }
   tinygltf::Mesh gm;
@@ -728,7 +802,8 @@ void GltfWriter::add_scene(const Scene& scene) {
     if (node.translation != Vec3f::Zero())
       gn.translation = {node.translation.x(), node.translation.y(), node.translation.z()};
     const Eigen::Quaternionf q = node.rotation.normalized();
-    if (!q.coeffs().isApprox(Eigen::Quaternionf::Identity().coeffs(), 0.0f)) gn.rotation = {q.x(), q.y(), q.z(), q.w()};
+    if (!q.coeffs().isApprox(Eigen::Quaternionf::Identity().coeffs(), 0.0f))
+      gn.rotation = {q.x(), q.y(), q.z(), q.w()};
     if (node.scale != Vec3f::Ones()) gn.scale = {node.scale.x(), node.scale.y(), node.scale.z()};
     for (size_t c = 0; c < scene.nodes.size(); ++c)
       if (scene.nodes[c].parent == static_cast<int>(i)) gn.children.push_back(static_cast<int>(c));
@@ -776,8 +851,9 @@ void GltfWriter::add_scene(const Scene& scene) {
       tinygltf::AnimationSampler sampler;
       sampler.interpolation = channel.interpolation == Interpolation::Linear ? "LINEAR"
                               : channel.interpolation == Interpolation::Step ? "STEP"
-                                                                              : "CUBICSPLINE";
-      sampler.input = accessor(channel.times.data(), channel.times.size(), TINYGLTF_TYPE_SCALAR, kFloat, 0, true);
+                                                                             : "CUBICSPLINE";
+      sampler.input =
+          accessor(channel.times.data(), channel.times.size(), TINYGLTF_TYPE_SCALAR, kFloat, 0, true);
       std::vector<float> values = channel.values;
       int type = TINYGLTF_TYPE_VEC3;
       size_t width = 3;
@@ -801,13 +877,15 @@ void GltfWriter::add_scene(const Scene& scene) {
       gc.target_path = channel.path == AnimationPath::Translation ? "translation"
                        : channel.path == AnimationPath::Rotation  ? "rotation"
                        : channel.path == AnimationPath::Scale     ? "scale"
-                                                                   : "weights";
+                                                                  : "weights";
       ga.channels.push_back(gc);
     }
     if (!ga.channels.empty()) model_.animations.push_back(ga);
   }
-  if (model_.buffers[0].data.empty()) model_.buffers.clear();
-  else model_.buffers[0].data.resize((model_.buffers[0].data.size() + 3) / 4 * 4, 0);
+  if (model_.buffers[0].data.empty())
+    model_.buffers.clear();
+  else
+    model_.buffers[0].data.resize((model_.buffers[0].data.size() + 3) / 4 * 4, 0);
 }
 
 std::string serialize(const Scene& scene, bool binary) {
@@ -827,6 +905,8 @@ std::vector<unsigned char> encode_glb(const Scene& scene) {
   return {bytes.begin(), bytes.end()};
 }
 
-std::string encode_gltf(const Scene& scene) { return serialize(scene, false); }
+std::string encode_gltf(const Scene& scene) {
+  return serialize(scene, false);
+}
 
 }  // namespace drape

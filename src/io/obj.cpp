@@ -4,11 +4,11 @@
 // faces with fewer than three corners and only warns about out-of-range indices. A light scan first
 // checks every v/vt/vn/f line (numbers present and finite, indices in range), so a bad file is refused
 // with its line number instead of being silently "fixed".
+#include <fmt/format.h>
 #include <tiny_obj_loader.h>
 
 #include <charconv>
 #include <cmath>
-#include <fmt/format.h>
 #include <map>
 #include <tuple>
 
@@ -19,7 +19,9 @@
 namespace drape::io {
 namespace {
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r';
+}
 
 // Splits a line into whitespace-separated tokens, stopping at a comment.
 std::vector<std::string_view> tokens_of(std::string_view line) {
@@ -101,11 +103,12 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
     for (size_t k = 0; k < part; ++k) {
       if (parts[k].empty() && k > 0) continue;  // v//n
       long index = 0;
-      if (!parse_index(parts[k], index)) fail(fmt::format("face corner '{}' has a bad {} index", printable(corner), names[k]));
+      if (!parse_index(parts[k], index))
+        fail(fmt::format("face corner '{}' has a bad {} index", printable(corner), names[k]));
       if (index < 0) {
         if (static_cast<size_t>(-index) > counts[k])
-          fail(fmt::format("face corner '{}': relative {} index {} points before the first one", printable(corner),
-                           names[k], index));
+          fail(fmt::format("face corner '{}': relative {} index {} points before the first one",
+                           printable(corner), names[k], index));
       } else if (index > maxima[k]->index) {
         *maxima[k] = {index, line_number};
       }
@@ -134,19 +137,21 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
       ++scan.normals;
     } else if (key == "f") {
       if (tok.size() - 1 < 3) ++scan.short_faces;
-      if (tok.size() - 1 > 255) fail(fmt::format("face has {} corners; at most 255 are supported", tok.size() - 1));
+      if (tok.size() - 1 > 255)
+        fail(fmt::format("face has {} corners; at most 255 are supported", tok.size() - 1));
       for (size_t i = 1; i < tok.size(); ++i) check_corner(tok[i]);
     } else if (key == "g" || key == "o") {
       scan.has_groups = true;
     }
   }
   // Positive indices may point forward, so they are checked against the final counts.
-  const std::tuple<MaxIndex, size_t, const char*> checks[3] = {
-      {max_v, scan.positions, "vertex"}, {max_vt, scan.texcoords, "texture coordinate"}, {max_vn, scan.normals, "normal"}};
+  const std::tuple<MaxIndex, size_t, const char*> checks[3] = {{max_v, scan.positions, "vertex"},
+                                                               {max_vt, scan.texcoords, "texture coordinate"},
+                                                               {max_vn, scan.normals, "normal"}};
   for (const auto& [max, count, name] : checks)
     if (static_cast<size_t>(max.index) > count)
-      throw InputError(source, fmt::format("line {}: {} index {} out of range (the file has {})", max.line, name,
-                                           max.index, count));
+      throw InputError(source, fmt::format("line {}: {} index {} out of range (the file has {})", max.line,
+                                           name, max.index, count));
   if (scan.every_vertex_has_color && scan.positions == 0) scan.every_vertex_has_color = false;
   return scan;
 }
@@ -190,8 +195,9 @@ Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& che
     const std::pair<int, int> attributes{idx.texcoord_index, idx.normal_index};
     if (slot[v].first == kUnset) slot[v] = attributes;
     if (slot[v] == attributes) return static_cast<uint32_t>(v);
-    const auto [it, inserted] = copies.try_emplace({idx.vertex_index, idx.texcoord_index, idx.normal_index},
-                                                   static_cast<uint32_t>(file_vertices + source_vertex.size()));
+    const auto [it, inserted] =
+        copies.try_emplace({idx.vertex_index, idx.texcoord_index, idx.normal_index},
+                           static_cast<uint32_t>(file_vertices + source_vertex.size()));
     if (inserted) {
       source_vertex.push_back(idx.vertex_index);
       copy_attributes.push_back(attributes);
@@ -203,7 +209,8 @@ Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& che
   std::map<std::string, uint32_t> group_index;
   std::vector<uint32_t> corners;
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-    const auto [group, inserted] = group_index.try_emplace(shape.name, static_cast<uint32_t>(mesh.group_names.size()));
+    const auto [group, inserted] =
+        group_index.try_emplace(shape.name, static_cast<uint32_t>(mesh.group_names.size()));
     if (inserted) mesh.group_names.push_back(shape.name);
     size_t offset = 0;
     for (const unsigned char face_size : shape.mesh.num_face_vertices) {
@@ -229,12 +236,15 @@ Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& che
 
   // Attributes of every output vertex.
   const size_t n = mesh.positions.size();
-  const auto attributes_of = [&](size_t i) { return i < file_vertices ? slot[i] : copy_attributes[i - file_vertices]; };
+  const auto attributes_of = [&](size_t i) {
+    return i < file_vertices ? slot[i] : copy_attributes[i - file_vertices];
+  };
   if (any_uv) {
     mesh.uvs.assign(n, Vec2f::Zero());
     for (size_t i = 0; i < n; ++i)
       if (const int t = attributes_of(i).first; t >= 0)
-        mesh.uvs[i] = {attrib.texcoords[2 * static_cast<size_t>(t)], attrib.texcoords[2 * static_cast<size_t>(t) + 1]};
+        mesh.uvs[i] = {attrib.texcoords[2 * static_cast<size_t>(t)],
+                       attrib.texcoords[2 * static_cast<size_t>(t) + 1]};
   }
   if (every_normal && !mesh.triangles.empty()) {
     mesh.normals.assign(n, Vec3f::UnitY());  // unreferenced vertices
@@ -272,15 +282,16 @@ std::string encode_obj(const Mesh& mesh) {
   for (size_t i = 0; i < mesh.positions.size(); ++i) {
     const Vec3f& p = mesh.positions[i];
     if (colors)
-      fmt::format_to(std::back_inserter(buf), "v {} {} {} {} {} {}\n", p.x(), p.y(), p.z(), mesh.colors[i].x(),
-                     mesh.colors[i].y(), mesh.colors[i].z());
+      fmt::format_to(std::back_inserter(buf), "v {} {} {} {} {} {}\n", p.x(), p.y(), p.z(),
+                     mesh.colors[i].x(), mesh.colors[i].y(), mesh.colors[i].z());
     else
       fmt::format_to(std::back_inserter(buf), "v {} {} {}\n", p.x(), p.y(), p.z());
   }
   const bool uvs = mesh.uvs.size() == mesh.positions.size() && !mesh.uvs.empty();
   const bool normals = mesh.normals.size() == mesh.positions.size() && !mesh.normals.empty();
   for (const Vec2f& t : mesh.uvs) fmt::format_to(std::back_inserter(buf), "vt {} {}\n", t.x(), t.y());
-  for (const Vec3f& nrm : mesh.normals) fmt::format_to(std::back_inserter(buf), "vn {} {} {}\n", nrm.x(), nrm.y(), nrm.z());
+  for (const Vec3f& nrm : mesh.normals)
+    fmt::format_to(std::back_inserter(buf), "vn {} {} {}\n", nrm.x(), nrm.y(), nrm.z());
 
   const bool groups = !mesh.group_names.empty() && mesh.triangle_groups.size() == mesh.triangles.size();
   size_t current_group = SIZE_MAX;
@@ -293,10 +304,14 @@ std::string encode_obj(const Mesh& mesh) {
     buf.push_back('f');
     for (uint32_t v : mesh.triangles[f]) {
       const uint32_t i = v + 1;
-      if (uvs && normals) fmt::format_to(std::back_inserter(buf), " {}/{}/{}", i, i, i);
-      else if (uvs) fmt::format_to(std::back_inserter(buf), " {}/{}", i, i);
-      else if (normals) fmt::format_to(std::back_inserter(buf), " {}//{}", i, i);
-      else fmt::format_to(std::back_inserter(buf), " {}", i);
+      if (uvs && normals)
+        fmt::format_to(std::back_inserter(buf), " {}/{}/{}", i, i, i);
+      else if (uvs)
+        fmt::format_to(std::back_inserter(buf), " {}/{}", i, i);
+      else if (normals)
+        fmt::format_to(std::back_inserter(buf), " {}//{}", i, i);
+      else
+        fmt::format_to(std::back_inserter(buf), " {}", i);
     }
     buf.push_back('\n');
   }

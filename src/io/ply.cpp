@@ -5,12 +5,13 @@
 // name an element). The format is a text header and a flat table of typed values, so a careful reader
 // is about as long as the glue to such a library, and it bounds every count by the bytes actually
 // present before allocating (a fuzzed header cannot ask for terabytes).
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fmt/format.h>
 #include <optional>
 
 #include "drape/error.hpp"
@@ -38,18 +39,24 @@ std::optional<Type> type_named(std::string_view name) {
 size_t size_of(Type t) {
   switch (t) {
     case Type::Int8:
-    case Type::UInt8: return 1;
+    case Type::UInt8:
+      return 1;
     case Type::Int16:
-    case Type::UInt16: return 2;
+    case Type::UInt16:
+      return 2;
     case Type::Int32:
     case Type::UInt32:
-    case Type::Float32: return 4;
-    case Type::Float64: return 8;
+    case Type::Float32:
+      return 4;
+    case Type::Float64:
+      return 8;
   }
   return 0;
 }
 
-bool is_integer(Type t) { return t != Type::Float32 && t != Type::Float64; }
+bool is_integer(Type t) {
+  return t != Type::Float32 && t != Type::Float64;
+}
 
 struct Property {
   std::string name;
@@ -103,10 +110,14 @@ Header parse_header(std::string_view data, const std::string& source) {
     if (w[0] == "end_header") break;
     if (w[0] == "format") {
       if (w.size() != 3 || w[2] != "1.0") fail(line_number, "expected 'format <encoding> 1.0'");
-      if (w[1] == "ascii") header.encoding = Encoding::Ascii;
-      else if (w[1] == "binary_little_endian") header.encoding = Encoding::Little;
-      else if (w[1] == "binary_big_endian") header.encoding = Encoding::Big;
-      else fail(line_number, fmt::format("unknown encoding '{}'", printable(w[1])));
+      if (w[1] == "ascii")
+        header.encoding = Encoding::Ascii;
+      else if (w[1] == "binary_little_endian")
+        header.encoding = Encoding::Little;
+      else if (w[1] == "binary_big_endian")
+        header.encoding = Encoding::Big;
+      else
+        fail(line_number, fmt::format("unknown encoding '{}'", printable(w[1])));
       have_format = true;
     } else if (w[0] == "element") {
       size_t count = 0;
@@ -158,14 +169,22 @@ class BodyReader {
     pos_ += n;
     if ((encoding_ == Encoding::Big) != (std::endian::native == std::endian::big)) std::reverse(b, b + n);
     switch (type) {
-      case Type::Int8: return static_cast<int8_t>(b[0]);
-      case Type::UInt8: return b[0];
-      case Type::Int16: return load<int16_t>(b);
-      case Type::UInt16: return load<uint16_t>(b);
-      case Type::Int32: return load<int32_t>(b);
-      case Type::UInt32: return load<uint32_t>(b);
-      case Type::Float32: return load<float>(b);
-      case Type::Float64: return load<double>(b);
+      case Type::Int8:
+        return static_cast<int8_t>(b[0]);
+      case Type::UInt8:
+        return b[0];
+      case Type::Int16:
+        return load<int16_t>(b);
+      case Type::UInt16:
+        return load<uint16_t>(b);
+      case Type::Int32:
+        return load<int32_t>(b);
+      case Type::UInt32:
+        return load<uint32_t>(b);
+      case Type::Float32:
+        return load<float>(b);
+      case Type::Float64:
+        return load<double>(b);
     }
     return 0;
   }
@@ -225,8 +244,10 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
     if (e.count == 0) continue;
     // Each element takes at least one byte per property: a larger count cannot be in the file.
     if (e.count > reader.remaining() / e.properties.size())
-      throw InputError(source, fmt::format("truncated PLY data: header promises {} '{}' elements, the file is too "
-                                           "short for them", e.count, printable(e.name)));
+      throw InputError(source,
+                       fmt::format("truncated PLY data: header promises {} '{}' elements, the file is too "
+                                   "short for them",
+                                   e.count, printable(e.name)));
     const bool is_vertex = e.name == "vertex" && !have_vertices;
     const bool is_face = e.name == "face" && !have_faces;
     // Columns of interest; -1 when absent.
@@ -235,8 +256,10 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
     if (is_vertex) {
       have_vertices = true;
       xyz[0] = property_index(e, {"x"}), xyz[1] = property_index(e, {"y"}), xyz[2] = property_index(e, {"z"});
-      if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) throw InputError(source, "PLY vertex element lacks x, y or z");
-      nxyz[0] = property_index(e, {"nx"}), nxyz[1] = property_index(e, {"ny"}), nxyz[2] = property_index(e, {"nz"});
+      if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0)
+        throw InputError(source, "PLY vertex element lacks x, y or z");
+      nxyz[0] = property_index(e, {"nx"}), nxyz[1] = property_index(e, {"ny"}),
+      nxyz[2] = property_index(e, {"nz"});
       uv[0] = property_index(e, {"u", "s", "texture_u", "texture_s"});
       uv[1] = property_index(e, {"v", "t", "texture_v", "texture_t"});
       rgba[0] = property_index(e, {"red"}), rgba[1] = property_index(e, {"green"});
@@ -248,7 +271,8 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
     } else if (is_face) {
       have_faces = true;
       for (size_t i = 0; i < e.properties.size(); ++i)
-        if (e.properties[i].is_list && (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
+        if (e.properties[i].is_list &&
+            (e.properties[i].name == "vertex_indices" || e.properties[i].name == "vertex_index"))
           indices = static_cast<int>(i);
       if (indices < 0) throw InputError(source, "PLY face element lacks a vertex_indices list");
       if (!is_integer(e.properties[static_cast<size_t>(indices)].type))
@@ -292,7 +316,8 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
     }
   }
   if (!have_vertices) throw InputError(source, "PLY file has no vertex element");
-  if (!have_faces || polygons.empty()) throw InputError(source, "PLY file has no faces (a point cloud is not a mesh)");
+  if (!have_faces || polygons.empty())
+    throw InputError(source, "PLY file has no faces (a point cloud is not a mesh)");
 
   // Faces: indices in range, then triangulated; fewer than three corners count as degenerate.
   for (size_t f = 0; f < polygons.size(); ++f) {
@@ -340,16 +365,18 @@ std::vector<unsigned char> encode_ply(const Mesh& mesh, PlyEncoding encoding) {
   const bool normals = !mesh.normals.empty() && mesh.normals.size() == n;
   const bool uvs = !mesh.uvs.empty() && mesh.uvs.size() == n;
   const bool colors = !mesh.colors.empty() && mesh.colors.size() == n;
-  const char* format = encoding == PlyEncoding::Ascii               ? "ascii"
+  const char* format = encoding == PlyEncoding::Ascii                ? "ascii"
                        : encoding == PlyEncoding::BinaryLittleEndian ? "binary_little_endian"
                                                                      : "binary_big_endian";
-  std::string header = fmt::format("ply\nformat {} 1.0\ncomment written by drape {}\nelement vertex {}\n", format,
-                                   DRAPE_VERSION, n);
+  std::string header = fmt::format("ply\nformat {} 1.0\ncomment written by drape {}\nelement vertex {}\n",
+                                   format, DRAPE_VERSION, n);
   header += "property float x\nproperty float y\nproperty float z\n";
   if (normals) header += "property float nx\nproperty float ny\nproperty float nz\n";
   if (uvs) header += "property float s\nproperty float t\n";
-  if (colors) header += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
-  header += fmt::format("element face {}\nproperty list uchar uint vertex_indices\nend_header\n", mesh.triangles.size());
+  if (colors)
+    header += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
+  header += fmt::format("element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
+                        mesh.triangles.size());
 
   std::vector<unsigned char> out(header.begin(), header.end());
   const auto color_byte = [](float c) {
@@ -360,13 +387,17 @@ std::vector<unsigned char> encode_ply(const Mesh& mesh, PlyEncoding encoding) {
     for (size_t i = 0; i < n; ++i) {
       const Vec3f& p = mesh.positions[i];
       fmt::format_to(std::back_inserter(buf), "{} {} {}", p.x(), p.y(), p.z());
-      if (normals) fmt::format_to(std::back_inserter(buf), " {} {} {}", mesh.normals[i].x(), mesh.normals[i].y(), mesh.normals[i].z());
+      if (normals)
+        fmt::format_to(std::back_inserter(buf), " {} {} {}", mesh.normals[i].x(), mesh.normals[i].y(),
+                       mesh.normals[i].z());
       if (uvs) fmt::format_to(std::back_inserter(buf), " {} {}", mesh.uvs[i].x(), mesh.uvs[i].y());
       if (colors)
-        for (int c = 0; c < 4; ++c) fmt::format_to(std::back_inserter(buf), " {}", color_byte(mesh.colors[i][c]));
+        for (int c = 0; c < 4; ++c)
+          fmt::format_to(std::back_inserter(buf), " {}", color_byte(mesh.colors[i][c]));
       buf.push_back('\n');
     }
-    for (const Tri& t : mesh.triangles) fmt::format_to(std::back_inserter(buf), "3 {} {} {}\n", t[0], t[1], t[2]);
+    for (const Tri& t : mesh.triangles)
+      fmt::format_to(std::back_inserter(buf), "3 {} {} {}\n", t[0], t[1], t[2]);
     out.insert(out.end(), buf.data(), buf.data() + buf.size());
     return out;
   }

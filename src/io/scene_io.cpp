@@ -1,7 +1,8 @@
 // Reading and writing scenes by file: format detection, validation, unit/axis conversion, merging.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
-#include <fmt/format.h>
 #include <fstream>
 #include <iterator>
 
@@ -15,25 +16,35 @@ namespace drape {
 
 LoadOptions load_options(std::string_view units, std::string_view up) {
   LoadOptions options;
-  if (units == "mm") options.metres_per_unit = 0.001;
-  else if (units == "cm") options.metres_per_unit = 0.01;
-  else if (units == "dm") options.metres_per_unit = 0.1;
-  else if (units == "m") options.metres_per_unit = 1.0;
-  else throw InputError("--units", fmt::format("unknown unit '{}' (expected mm, cm, dm or m)", units));
-  if (up == "y" || up == "Y") options.up = UpAxis::Y;
-  else if (up == "z" || up == "Z") options.up = UpAxis::Z;
-  else throw InputError("--up", fmt::format("unknown up axis '{}' (expected y or z)", up));
+  if (units == "mm")
+    options.metres_per_unit = 0.001;
+  else if (units == "cm")
+    options.metres_per_unit = 0.01;
+  else if (units == "dm")
+    options.metres_per_unit = 0.1;
+  else if (units == "m")
+    options.metres_per_unit = 1.0;
+  else
+    throw InputError("--units", fmt::format("unknown unit '{}' (expected mm, cm, dm or m)", units));
+  if (up == "y" || up == "Y")
+    options.up = UpAxis::Y;
+  else if (up == "z" || up == "Z")
+    options.up = UpAxis::Z;
+  else
+    throw InputError("--up", fmt::format("unknown up axis '{}' (expected y or z)", up));
   return options;
 }
 
 MeshFormat mesh_format_of(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == ".obj") return MeshFormat::Obj;
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".glb") return MeshFormat::Glb;
   if (ext == ".gltf") return MeshFormat::Gltf;
-  throw InputError(path.string(), fmt::format("unknown mesh format '{}' (expected .obj, .ply, .glb or .gltf)", ext));
+  throw InputError(path.string(),
+                   fmt::format("unknown mesh format '{}' (expected .obj, .ply, .glb or .gltf)", ext));
 }
 
 namespace {
@@ -53,7 +64,8 @@ std::vector<unsigned char> read_file_bytes(const std::filesystem::path& path) {
 MeshFormat sniff_format(std::span<const unsigned char> bytes, MeshFormat by_extension) {
   const std::string_view head(reinterpret_cast<const char*>(bytes.data()), std::min<size_t>(bytes.size(), 5));
   if (head.substr(0, 4) == "glTF") return MeshFormat::Glb;
-  if (head.size() >= 4 && head.substr(0, 3) == "ply" && (head[3] == '\n' || head[3] == '\r')) return MeshFormat::Ply;
+  if (head.size() >= 4 && head.substr(0, 3) == "ply" && (head[3] == '\n' || head[3] == '\r'))
+    return MeshFormat::Ply;
   return by_extension;
 }
 
@@ -67,13 +79,17 @@ Scene parse_scene(std::span<const unsigned char> bytes, MeshFormat format, const
   Scene scene;
   switch (format) {
     case MeshFormat::Obj:
-      scene = io::parse_obj(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), source, check);
+      scene = io::parse_obj(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                            source, check);
       break;
-    case MeshFormat::Ply: scene = io::parse_ply(bytes, source, check); break;
+    case MeshFormat::Ply:
+      scene = io::parse_ply(bytes, source, check);
+      break;
     case MeshFormat::Glb:
     case MeshFormat::Gltf: {
       const std::filesystem::path dir = std::filesystem::path(source).parent_path();
-      scene = io::parse_gltf(bytes, format == MeshFormat::Glb, source, dir.empty() ? "." : dir.string(), check);
+      scene =
+          io::parse_gltf(bytes, format == MeshFormat::Glb, source, dir.empty() ? "." : dir.string(), check);
       break;
     }
   }
@@ -85,13 +101,15 @@ Scene parse_scene(std::span<const unsigned char> bytes, MeshFormat format, const
     scene.nodes[0].name = stem;
   }
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
-    const std::string what = scene.meshes.size() == 1 && (format == MeshFormat::Obj || format == MeshFormat::Ply)
-                                 ? std::string("mesh")
-                                 : io::element_name("mesh", m, scene.meshes[m].name);
+    const std::string what =
+        scene.meshes.size() == 1 && (format == MeshFormat::Obj || format == MeshFormat::Ply)
+            ? std::string("mesh")
+            : io::element_name("mesh", m, scene.meshes[m].name);
     io::validate_mesh(scene.meshes[m], source, what, check);
   }
   if (options.metres_per_unit != 1.0 || options.up != UpAxis::Y) {
-    const Eigen::Matrix3f axes = options.up == UpAxis::Z ? geometry::z_up_to_y_up() : Eigen::Matrix3f::Identity();
+    const Eigen::Matrix3f axes =
+        options.up == UpAxis::Z ? geometry::z_up_to_y_up() : Eigen::Matrix3f::Identity();
     geometry::change_frame(scene, static_cast<float>(options.metres_per_unit), axes);
   }
   if (check_out) *check_out = check;
@@ -132,7 +150,8 @@ Mesh merge_scene(const Scene& scene) {
   Mesh out;
   if (parts.empty()) return out;
   const auto all = [&](auto has) {
-    return std::all_of(parts.begin(), parts.end(), [&](const Part& p) { return has(scene.meshes[static_cast<size_t>(p.mesh)]); });
+    return std::all_of(parts.begin(), parts.end(),
+                       [&](const Part& p) { return has(scene.meshes[static_cast<size_t>(p.mesh)]); });
   };
   const bool normals = all([](const Mesh& m) { return !m.normals.empty(); });
   const bool uvs = all([](const Mesh& m) { return !m.uvs.empty(); });
@@ -190,10 +209,18 @@ Mesh read_mesh(const std::filesystem::path& path, const LoadOptions& options, Me
 
 void write_scene(const std::filesystem::path& path, const Scene& scene) {
   switch (mesh_format_of(path)) {
-    case MeshFormat::Obj: write_file_atomic(path, encode_obj(merge_scene(scene))); break;
-    case MeshFormat::Ply: write_file_atomic(path, encode_ply(merge_scene(scene))); break;
-    case MeshFormat::Glb: write_file_atomic(path, encode_glb(scene)); break;
-    case MeshFormat::Gltf: write_file_atomic(path, encode_gltf(scene)); break;
+    case MeshFormat::Obj:
+      write_file_atomic(path, encode_obj(merge_scene(scene)));
+      break;
+    case MeshFormat::Ply:
+      write_file_atomic(path, encode_ply(merge_scene(scene)));
+      break;
+    case MeshFormat::Glb:
+      write_file_atomic(path, encode_glb(scene));
+      break;
+    case MeshFormat::Gltf:
+      write_file_atomic(path, encode_gltf(scene));
+      break;
   }
 }
 

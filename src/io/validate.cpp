@@ -1,5 +1,6 @@
-#include <cmath>
 #include <fmt/format.h>
+
+#include <cmath>
 
 #include "drape/error.hpp"
 #include "geometry/topology.hpp"
@@ -33,7 +34,8 @@ std::string printable(std::string_view token) {
 }
 
 std::string element_name(const char* kind, size_t index, const std::string& name) {
-  return name.empty() ? fmt::format("{} {}", kind, index) : fmt::format("{} {} '{}'", kind, index, printable(name));
+  return name.empty() ? fmt::format("{} {}", kind, index)
+                      : fmt::format("{} {} '{}'", kind, index, printable(name));
 }
 
 namespace {
@@ -74,14 +76,16 @@ void validate_mesh(Mesh& mesh, const std::string& source, const std::string& wha
   for (const MorphTarget& target : mesh.morph_targets) {
     require_size(target.position_deltas.size(), "morph position deltas");
     require_size(target.normal_deltas.size(), "morph normal deltas");
-    require_finite(target.position_deltas, source, what + " morph target '" + target.name + "'", "position delta");
-    require_finite(target.normal_deltas, source, what + " morph target '" + target.name + "'", "normal delta");
+    require_finite(target.position_deltas, source, what + " morph target '" + target.name + "'",
+                   "position delta");
+    require_finite(target.normal_deltas, source, what + " morph target '" + target.name + "'",
+                   "normal delta");
   }
   for (size_t f = 0; f < mesh.triangles.size(); ++f)
     for (uint32_t v : mesh.triangles[f])
       if (v >= n)
-        throw InputError(source, fmt::format("{}: triangle {} uses vertex {} but there are only {} vertices", what,
-                                             f, v, n));
+        throw InputError(source, fmt::format("{}: triangle {} uses vertex {} but there are only {} vertices",
+                                             what, f, v, n));
   if (mesh.triangles.empty()) throw InputError(source, what + " has no faces");
 
   // Drop degenerate triangles (and their group entries), counting them.
@@ -94,7 +98,8 @@ void validate_mesh(Mesh& mesh, const std::string& source, const std::string& wha
     ++kept;
   }
   check.degenerate_faces_removed += mesh.triangles.size() - kept;
-  if (kept == 0) throw InputError(source, fmt::format("{}: all {} faces are degenerate", what, mesh.triangles.size()));
+  if (kept == 0)
+    throw InputError(source, fmt::format("{}: all {} faces are degenerate", what, mesh.triangles.size()));
   mesh.triangles.resize(kept);
   if (grouped) mesh.triangle_groups.resize(kept);
   if (!grouped && !mesh.triangle_groups.empty()) mesh.triangle_groups.clear();

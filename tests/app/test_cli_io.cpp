@@ -19,7 +19,9 @@ std::string quoted(const fs::path& p) {
   return q;
 }
 
-size_t lines(const std::string& s) { return static_cast<size_t>(std::count(s.begin(), s.end(), '\n')); }
+size_t lines(const std::string& s) {
+  return static_cast<size_t>(std::count(s.begin(), s.end(), '\n'));
+}
 
 }  // namespace
 
@@ -31,7 +33,8 @@ TEST(CliInfo, EveryBodyMeshLoadsWithAPlausibleHeight) {
     if (ext != ".obj" && ext != ".glb" && ext != ".ply" && ext != ".gltf") continue;
     // The raw MakeHuman base mesh is in decimetres (and carries helper geometry).
     const bool decimetres = entry.path().filename() == "base.obj";
-    const auto r = run_drape("info --json " + std::string(decimetres ? "--units dm " : "") + quoted(entry.path()));
+    const auto r =
+        run_drape("info --json " + std::string(decimetres ? "--units dm " : "") + quoted(entry.path()));
     ASSERT_EQ(r.exit_code, 0) << entry.path() << ": " << r.err;
     const auto j = nlohmann::json::parse(r.out);
     const double height = j["height_m"].get<double>();
@@ -70,7 +73,8 @@ TEST(CliConvert, ObjToGlbToPlyKeepsTheMeshAndValidates) {
     f << "v 0 0 0\nv 100 0 0\nv 100 0 -100\nv 0 0 -100\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
   }
   // Centimetres, Z-up: (x, y, z) cm -> (x, z, -y) m, so the 1 m quad in y = 0 ends up in z = 0.
-  auto r = run_drape("convert --units cm --up z " + quoted(dir / "quad.obj") + " " + quoted(dir / "quad.glb"));
+  auto r =
+      run_drape("convert --units cm --up z " + quoted(dir / "quad.obj") + " " + quoted(dir / "quad.glb"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(drape::test::gltf_is_valid(dir / "quad.glb"));
   r = run_drape("convert " + quoted(dir / "quad.glb") + " " + quoted(dir / "quad.ply"));

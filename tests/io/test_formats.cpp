@@ -72,7 +72,8 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   ASSERT_EQ(a.positions.size(), b.positions.size());
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   for (size_t i = 0; i < a.positions.size(); ++i) EXPECT_EQ(a.positions[i], b.positions[i]) << "vertex " << i;
-  for (size_t i = 0; i < a.triangles.size(); ++i) EXPECT_EQ(a.triangles[i], b.triangles[i]) << "triangle " << i;
+  for (size_t i = 0; i < a.triangles.size(); ++i)
+    EXPECT_EQ(a.triangles[i], b.triangles[i]) << "triangle " << i;
   ASSERT_EQ(a.uvs.size(), b.uvs.size());
   for (size_t i = 0; i < a.uvs.size(); ++i) EXPECT_EQ(a.uvs[i], b.uvs[i]) << "uv " << i;
 }
@@ -156,8 +157,9 @@ TEST(Obj, DegenerateFacesAreDroppedAndCounted) {
 
 TEST(Topology, CountsHolesAndNonManifoldEdges) {
   // Three triangles on one edge (a "book"), plus a separate triangle.
-  const char* obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 5 0 0\nv 6 0 0\nv 5 1 0\n"
-                    "f 1 2 3\nf 2 1 4\nf 1 2 5\nf 6 7 8\n";
+  const char* obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 5 0 0\nv 6 0 0\nv 5 1 0\n"
+      "f 1 2 3\nf 2 1 4\nf 1 2 5\nf 6 7 8\n";
   MeshCheck check;
   parse_text(obj, MeshFormat::Obj, &check);
   EXPECT_EQ(check.non_manifold_edges, 1u);
@@ -201,7 +203,8 @@ TEST(Ply, AsciiAndBinaryEncodingsReadTheSame) {
     ASSERT_EQ(r->normals.size(), m.normals.size());
     for (size_t i = 0; i < m.normals.size(); ++i) EXPECT_LT((r->normals[i] - m.normals[i]).norm(), 1e-6f);
     ASSERT_EQ(r->colors.size(), m.colors.size());
-    for (size_t i = 0; i < m.colors.size(); ++i) EXPECT_LT((r->colors[i] - m.colors[i]).norm(), 0.5f / 255.0f);
+    for (size_t i = 0; i < m.colors.size(); ++i)
+      EXPECT_LT((r->colors[i] - m.colors[i]).norm(), 0.5f / 255.0f);
   }
   EXPECT_NE(encode_ply(m, PlyEncoding::BinaryLittleEndian), encode_ply(m, PlyEncoding::BinaryBigEndian));
 }
@@ -212,7 +215,8 @@ TEST(Ply, ReadsForeignPropertiesListsAndQuads) {
       "ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 4\nproperty double x\nproperty double y\n"
       "property double z\nproperty float confidence\nproperty float u\nproperty float v\n"
       "element face 1\nproperty list int int vertex_index\nelement edge 1\nproperty int vertex1\n"
-      "property int vertex2\nend_header\n0 0 0 1 0 0\n1 0 0 1 1 0\n1 1 0 1 1 1\n0 1 0 1 0 1\n4 0 1 2 3\n0 1\n";
+      "property int vertex2\nend_header\n0 0 0 1 0 0\n1 0 0 1 1 0\n1 1 0 1 1 1\n0 1 0 1 0 1\n4 0 1 2 3\n0 "
+      "1\n";
   MeshCheck check;
   const Mesh m = merge_scene(parse_text(ply, MeshFormat::Ply, &check));
   EXPECT_EQ(m.triangles.size(), 2u);
@@ -226,13 +230,15 @@ TEST(Ply, TruncatedAndWrongCountsAreRefused) {
   std::vector<unsigned char> bin = encode_ply(m, PlyEncoding::BinaryLittleEndian);
   bin.resize(bin.size() - 5);
   EXPECT_THROW(parse_scene(bin, MeshFormat::Ply, "t.ply"), InputError);
-  std::string text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
+  std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n";
   try {
     parse_text(text, MeshFormat::Ply);
     ADD_FAILURE() << "out-of-range index accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("face 0: vertex index 3 out of range"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("face 0: vertex index 3 out of range"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -257,7 +263,8 @@ TEST(Gltf, SkinnedBodySurvivesReadWriteAndValidates) {
   ASSERT_EQ(b.skins.size(), 1u);
   EXPECT_EQ(b.skins[0].joints, a.skins[0].joints);
   for (size_t j = 0; j < a.skins[0].joints.size(); ++j)
-    EXPECT_TRUE(b.skins[0].inverse_bind_matrices[j].isApprox(a.skins[0].inverse_bind_matrices[j], 1e-6f)) << j;
+    EXPECT_TRUE(b.skins[0].inverse_bind_matrices[j].isApprox(a.skins[0].inverse_bind_matrices[j], 1e-6f))
+        << j;
   const Mesh& ma = a.meshes[0];
   const Mesh& mb = b.meshes[0];
   EXPECT_EQ(mb.positions, ma.positions);
@@ -301,9 +308,14 @@ TEST(Gltf, AnimationsMorphTargetsAndHierarchyRoundTrip) {
   s.skins[0].inverse_bind_matrices[0](1, 3) = -1.0f;
   Animation walk;
   walk.name = "walk";
-  walk.channels.push_back({1, AnimationPath::Translation, Interpolation::Linear, {0, 1}, {0, 1, 0, 0, 1.1f, 0}});
-  walk.channels.push_back({2, AnimationPath::Rotation, Interpolation::Step, {0, 0.5f}, {0, 0, 0, 1, 0.1987f, 0, 0, 0.98f}});
-  walk.channels.push_back({1, AnimationPath::Scale, Interpolation::CubicSpline, {0, 1},
+  walk.channels.push_back(
+      {1, AnimationPath::Translation, Interpolation::Linear, {0, 1}, {0, 1, 0, 0, 1.1f, 0}});
+  walk.channels.push_back(
+      {2, AnimationPath::Rotation, Interpolation::Step, {0, 0.5f}, {0, 0, 0, 1, 0.1987f, 0, 0, 0.98f}});
+  walk.channels.push_back({1,
+                           AnimationPath::Scale,
+                           Interpolation::CubicSpline,
+                           {0, 1},
                            {0, 0, 0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 2, 2, 2, 0, 0, 0}});
   walk.channels.push_back({0, AnimationPath::Weights, Interpolation::Linear, {0, 1, 2}, {0, 1, 0}});
   s.animations.push_back(walk);
@@ -330,7 +342,8 @@ TEST(Gltf, AnimationsMorphTargetsAndHierarchyRoundTrip) {
     EXPECT_EQ(y.times, x.times);
     ASSERT_EQ(y.values.size(), x.values.size());
     // Rotation keys are written as unit quaternions; the rest exactly.
-    for (size_t k = 0; k < x.values.size(); ++k) EXPECT_NEAR(y.values[k], x.values[k], 2e-3f) << c << " " << k;
+    for (size_t k = 0; k < x.values.size(); ++k)
+      EXPECT_NEAR(y.values[k], x.values[k], 2e-3f) << c << " " << k;
   }
   EXPECT_TRUE(r.skins[0].inverse_bind_matrices[0].isApprox(s.skins[0].inverse_bind_matrices[0]));
   fs::remove_all(dir);
@@ -342,7 +355,8 @@ TEST(Units, CentimetreZUpCopyLoadsLikeTheMetreYUpOriginal) {
   Mesh scanned = original;
   for (Vec3f& p : scanned.positions) p = 100.0f * Vec3f(p.x(), -p.z(), p.y());
   MeshCheck check;
-  const Mesh loaded = merge_scene(parse_text(encode_obj(scanned), MeshFormat::Obj, &check, load_options("cm", "z")));
+  const Mesh loaded =
+      merge_scene(parse_text(encode_obj(scanned), MeshFormat::Obj, &check, load_options("cm", "z")));
   ASSERT_EQ(loaded.positions.size(), original.positions.size());
   for (size_t i = 0; i < original.positions.size(); ++i)
     EXPECT_LT((loaded.positions[i] - original.positions[i]).norm(), 1e-6f) << i;
@@ -361,7 +375,8 @@ TEST(Units, ZUpSkinnedSceneConvertsConsistently) {
   r << 1, 0, 0, 0, 0, 1, 0, -1, 0;  // (x, y, z) -> (x, z, -y)
   for (size_t j = 0; j < skin.joints.size(); ++j) {
     const Mat4f product = converted.world_transform(skin.joints[j]) * skin.inverse_bind_matrices[j];
-    const Mat4f original = y_up.world_transform(y_up.skins[0].joints[j]) * y_up.skins[0].inverse_bind_matrices[j];
+    const Mat4f original =
+        y_up.world_transform(y_up.skins[0].joints[j]) * y_up.skins[0].inverse_bind_matrices[j];
     const Eigen::Matrix3f expected = r * original.topLeftCorner<3, 3>() * r.transpose();
     const Eigen::Matrix3f linear = product.topLeftCorner<3, 3>();
     EXPECT_TRUE(linear.isApprox(expected, 1e-4f)) << j;

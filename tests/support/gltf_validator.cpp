@@ -1,15 +1,17 @@
 #include "support/gltf_validator.hpp"
 
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <nlohmann/json.hpp>
-#include <sys/wait.h>
 
 namespace drape::test {
 
 GltfValidation validate_gltf(const std::filesystem::path& file) {
   GltfValidation result;
-  const std::filesystem::path script = std::filesystem::path(DRAPE_SOURCE_DIR) / "tools" / "gltf_validate.mjs";
+  const std::filesystem::path script =
+      std::filesystem::path(DRAPE_SOURCE_DIR) / "tools" / "gltf_validate.mjs";
   const std::string cmd = "node \"" + script.string() + "\" \"" + file.string() + "\" 2>&1";
   std::FILE* pipe = ::popen(cmd.c_str(), "r");
   if (!pipe) {
@@ -34,8 +36,8 @@ GltfValidation validate_gltf(const std::filesystem::path& file) {
   const GltfValidation v = validate_gltf(file);
   if (v.errors == 0) return ::testing::AssertionSuccess();
   if (v.errors < 0)
-    return ::testing::AssertionFailure() << "glTF validator did not run on " << file
-                                         << " (run `make deps`): " << v.report;
+    return ::testing::AssertionFailure()
+           << "glTF validator did not run on " << file << " (run `make deps`): " << v.report;
   return ::testing::AssertionFailure() << file << ": " << v.errors << " validator errors: " << v.report;
 }
 

@@ -1,8 +1,9 @@
 #pragma once
 // Runs the Khronos glTF validator (tools/gltf_validate.mjs, installed by `make deps`) on a file a test
 // wrote. A missing node or validator is a failure, not a skip: `make test` always runs `make deps` first.
-#include <filesystem>
 #include <gtest/gtest.h>
+
+#include <filesystem>
 #include <string>
 
 namespace drape::test {

@@ -16,6 +16,7 @@ void add_convert_command(CLI::App& app);
 void add_render_command(CLI::App& app);  // cmd_render.cpp: pictures of mesh files
 void add_scene_command(CLI::App& app);  // cmd_scene.cpp: paper fig. 7 draping scenes
 void add_garment_command(CLI::App& app);  // cmd_garment.cpp: `garments`, `garment check|mesh`
+void add_dress_command(CLI::App& app);  // cmd_dress.cpp: dress a body in garments (paper sec. 6)
 void add_body_command(CLI::App& app);     // cmd_body.cpp: a rigged body from measurements
 void add_measure_command(CLI::App& app);  // cmd_measure.cpp: landmarks and measurements of a body
 

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   drape::app::add_render_command(app);
   drape::app::add_scene_command(app);
   drape::app::add_garment_command(app);
+  drape::app::add_dress_command(app);
   drape::app::add_body_command(app);
   drape::app::add_measure_command(app);
 

@@ -1,0 +1,137 @@
+#pragma once
+// Dressing a body in garments made from 2D cutting patterns (Vassilev & Spanlang sec. 6):
+//
+//   body -> garment in size -> meshed panels -> panels placed around the body -> one cloth model
+//   with seam springs -> sewing (seam forces, no gravity, body collision) -> draping (gravity)
+//   -> next garment (the dressed ones are colliders, sec. 6) -> quality.
+//
+// The pipeline is dress(); every stage is a public function so tests and benchmarks can run
+// them one at a time. See docs/dressing.md for the placement, the sewing and settling criteria
+// and the quality gates.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "drape/body.hpp"
+#include "drape/cloth.hpp"
+#include "drape/collision.hpp"
+#include "drape/fabric.hpp"
+#include "drape/fit.hpp"
+#include "drape/garment.hpp"
+#include "drape/scene.hpp"
+
+namespace drape {
+
+// Grid spacing that gives the built-in shirt about the paper's 1800 vertices (Table 2).
+inline constexpr double kPaperEdgeLength = 0.026;
+
+struct DressOptions {
+  CollisionMethod collision = CollisionMethod::image;
+  MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
+  std::string fabric;  // empty: each garment's own
+  // Sewing: seam springs pull the pairs together with gravity off until every pair is closer
+  // than `seam_closed_m`, for at most `max_sewing_seconds` of simulated time.
+  float seam_closed_m = 0.0015f;
+  double max_sewing_seconds = 1.5;
+  // Draping: gravity on until settled, for at most `max_drape_seconds`.
+  double max_drape_seconds = 2.0;
+  // Settled: every vertex slower than `settle_speed` for `settle_window_s` consecutive seconds.
+  float settle_speed = 0.05f;      // m/s
+  double settle_window_s = 0.05;   // s
+  // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
+  uint64_t max_iterations = 0;
+  // false: stop after placement (to inspect where the panels start); the run is not settled.
+  bool simulate = true;
+  QualityGates gates{};
+};
+
+// Where a panel ended up and why.
+struct PanelPlacement {
+  std::string panel;
+  std::string region;   // "torso", "left_arm", ... or "transform" (the file's 3D placement)
+  float clearance = 0;  // m, after growing it to clear the body
+  size_t vertices_touching = 0;  // vertices still within the collision thickness after placement
+};
+
+// One garment put on the body.
+struct DressedGarment {
+  std::string name, size, fabric;
+  ClothModel model;
+  ClothState state;
+  std::vector<std::array<uint32_t, 2>> seam_pairs;  // particle pairs sewn together
+  std::vector<uint32_t> panel_first_vertex;         // particle range of each panel (+ end)
+  std::vector<std::string> panel_names;
+  std::vector<PanelPlacement> placement;
+
+  // Measured on the way.
+  uint64_t sewing_iterations = 0, drape_iterations = 0;
+  double sewing_seconds = 0, drape_seconds = 0;  // wall
+  bool seams_closed = false, settled = false;
+  StepStatus status = StepStatus::Ok;
+  float initial_max_gap = 0;   // m, right after placement
+  float time_step = 0;         // s
+  float drop_m = 0;            // centre of mass fall while draping
+  StepProfile profile;
+
+  Mesh mesh() const;  // positions, normals, TEXCOORD_0 = flat pattern coordinates (m)
+};
+
+struct DressProgress {
+  size_t garment = 0, garments = 0;
+  const char* phase = "";  // "sewing" or "draping"
+  uint64_t iterations = 0;
+  double simulated_seconds = 0, phase_limit_seconds = 0;
+};
+using DressProgressCallback = std::function<void(const DressProgress&)>;
+
+struct DressResult {
+  std::vector<DressedGarment> garments;  // innermost first
+  FitQuality quality;
+  SimulationSummary simulation;
+  std::vector<GateResult> gates;
+  double setup_seconds = 0;  // body analysis, meshing, placement, colliders (not in Table 2's times)
+  bool passed() const { return all_passed(gates); }
+};
+
+// A garment request: a loaded spec and the size to make (empty: the spec's base size).
+struct GarmentRequest {
+  GarmentSpec spec;
+  std::string size;
+};
+
+// --- The stages ---------------------------------------------------------------------------------
+
+// Panels meshed flat (stage 2) and rolled around the body (stage 3): a cloth model whose springs
+// include zero-length seam springs between the sewn pairs (stage 4), ready to sew.
+DressedGarment prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
+                               const DressOptions& options);
+
+// Stages 5: sews then drapes `garment` on the colliders (body first, then dressed garments).
+void sew_and_drape(DressedGarment& garment, std::span<Collider* const> colliders, const DressOptions& options,
+                   const DressProgressCallback& progress = {}, size_t index = 0, size_t count = 1);
+
+// A dressed garment as a collider for the next layer: its surface pushed out by its thickness.
+std::unique_ptr<Collider> garment_collider(const DressedGarment& garment);
+
+// Stage 7: quality over all garments against the body.
+FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garments);
+
+// The whole pipeline. Layer order = request order (innermost first). Throws InputError for bad
+// garments (naming the file) and for meshing failures.
+DressResult dress(const Body& body, const std::vector<GarmentRequest>& garments, const DressOptions& options = {},
+                  const DressProgressCallback& progress = {});
+
+// --- Outputs --------------------------------------------------------------------------------------
+
+// glTF scene: node `body`, then one node per garment (named after it).
+Scene dressed_scene(const Body& body, const DressResult& result);
+// report.json text: DESIGN.md's keys, gates, per-garment details and the stage profile.
+std::string dress_report_json(const Body& body, const DressResult& result, const DressOptions& options);
+// Writes dressed.glb, preview.png and report.json into `dir`, each atomically.
+void write_dress_outputs(const std::filesystem::path& dir, const Body& body, const DressResult& result,
+                         const DressOptions& options);
+
+}  // namespace drape

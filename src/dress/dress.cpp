@@ -1,0 +1,107 @@
+// The dressing pipeline (Vassilev & Spanlang sec. 6, docs/dressing.md): each garment in turn is
+// meshed, placed, sewn and draped with the body and the garments already dressed as colliders.
+#include <chrono>
+
+#include "dress/stages.hpp"
+#include "drape/error.hpp"
+
+namespace drape {
+
+DressedGarment prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
+                               const DressOptions& o) {
+  DressedGarment g;
+  g.name = garment.name;
+  g.size = garment.size;
+  const Fabric fabric = fabric_or_throw(o.fabric.empty() ? garment.fabric : o.fabric);
+  g.fabric = fabric.name;
+  const GarmentMesh mesh = mesh_garment(garment, o.mesh);
+  dressing::PlacedPanels placed = dressing::place_panels(body, garment, mesh, body_collider, fabric.collision_thickness);
+  dressing::GarmentCloth cloth = dressing::garment_cloth_spec(garment, mesh, placed, fabric);
+  g.model = compile(std::move(cloth.spec));
+  g.state = initial_state(g.model);
+  g.seam_pairs = std::move(cloth.seam_pairs);
+  g.panel_first_vertex = std::move(cloth.panel_first_vertex);
+  for (const Panel& p : garment.panels) g.panel_names.push_back(p.name);
+  g.placement = std::move(placed.info);
+  return g;
+}
+
+FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garments) {
+  FitQuality q;
+  const InsideTest inside(body.mesh);
+  std::vector<float> all_strain;
+  double gap_sum = 0;
+  size_t gap_pairs = 0;
+  q.settled = !garments.empty();
+  q.lowest_y = std::numeric_limits<float>::infinity();
+  for (const DressedGarment& g : garments) {
+    const GarmentMeasure m = measure_garment(g.model, g.state.x, inside);
+    q.finite = q.finite && m.finite && g.status == StepStatus::Ok;
+    q.max_strain = std::max(q.max_strain, m.strain.max);
+    all_strain.insert(all_strain.end(), m.structural_strain.begin(), m.structural_strain.end());
+    q.penetrating_vertices += m.penetration.penetrating;
+    q.max_penetration_m = std::max(q.max_penetration_m, m.penetration.max_depth_m);
+    q.vertices += g.state.x.size();
+    const SeamGapStats gaps = seam_gap_stats(g.state.x, g.seam_pairs);
+    q.max_seam_gap_m = std::max(q.max_seam_gap_m, gaps.max);
+    gap_sum += static_cast<double>(gaps.mean) * static_cast<double>(gaps.pairs);
+    gap_pairs += gaps.pairs;
+    q.settled = q.settled && g.settled;
+    q.lowest_y = std::min(q.lowest_y, m.lowest_y);
+    q.drop_m = std::max(q.drop_m, g.drop_m);
+  }
+  if (!all_strain.empty()) {
+    const size_t k = std::min(all_strain.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(all_strain.size())));
+    std::nth_element(all_strain.begin(), all_strain.begin() + static_cast<std::ptrdiff_t>(k), all_strain.end());
+    q.p99_strain = all_strain[k];
+  }
+  q.mean_seam_gap_m = gap_pairs ? static_cast<float>(gap_sum / static_cast<double>(gap_pairs)) : 0.0f;
+  q.penetration_fraction = q.vertices ? static_cast<double>(q.penetrating_vertices) / static_cast<double>(q.vertices) : 0.0;
+  if (!q.finite) q.settled = false;
+  return q;
+}
+
+DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests, const DressOptions& o,
+                  const DressProgressCallback& progress) {
+  DressResult result;
+  const auto clock = [] { return std::chrono::steady_clock::now(); };
+  const auto since = [&](auto t) { return std::chrono::duration<double>(clock() - t).count(); };
+
+  // Sizes resolved and validated up front, so bad input stops the run before anything is simulated.
+  std::vector<Garment> garments;
+  for (const GarmentRequest& r : requests) garments.push_back(garment_in_size(r.spec, r.size));
+
+  auto t0 = clock();
+  std::unique_ptr<BodyCollider> body_collider = make_body_collider(body.mesh, o.collision);
+  std::vector<std::unique_ptr<Collider>> layers;
+  std::vector<Collider*> colliders{body_collider.get()};
+  result.setup_seconds += since(t0);
+
+  for (size_t i = 0; i < garments.size(); ++i) {
+    t0 = clock();
+    DressedGarment g = prepare_garment(body, garments[i], *body_collider, o);
+    result.setup_seconds += since(t0);
+    sew_and_drape(g, colliders, o, progress, i, garments.size());
+    result.simulation.iterations += g.state.iterations;
+    result.simulation.wall_seconds += g.sewing_seconds + g.drape_seconds;
+    result.simulation.time_step_s = std::max(result.simulation.time_step_s, static_cast<double>(g.time_step));
+    // The dressed garment is a solid for the next one (sec. 6).
+    if (i + 1 < garments.size() && g.status == StepStatus::Ok) {
+      t0 = clock();
+      layers.push_back(garment_collider(g));
+      colliders.push_back(layers.back().get());
+      result.setup_seconds += since(t0);
+    }
+    result.garments.push_back(std::move(g));
+  }
+  const auto& s = result.simulation;
+  result.simulation.seconds_per_iteration = s.iterations ? s.wall_seconds / static_cast<double>(s.iterations) : 0.0;
+
+  result.quality = measure_fit(body, result.garments);
+  float threshold = 0;
+  for (const DressedGarment& g : result.garments) threshold = std::max(threshold, g.model.fabric.strain_threshold);
+  result.gates = evaluate_gates(result.quality, threshold, o.gates);
+  return result;
+}
+
+}  // namespace drape

@@ -1,0 +1,133 @@
+// Stage 8: dressed.glb (node `body`, then one node per garment, TEXCOORD_0 = flat pattern metres),
+// preview.png (front, side, back; second row: structural strain), report.json. Each written
+// atomically; the directory gets all three or, on an error before writing, none.
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/dress.hpp"
+#include "drape/files.hpp"
+#include "drape/io.hpp"
+#include "drape/render.hpp"
+
+namespace drape {
+
+Scene dressed_scene(const Body& body, const DressResult& result) {
+  Scene scene = body_scene(body);
+  std::vector<std::string> used{"body"};
+  for (const DressedGarment& g : result.garments) {
+    std::string name = g.name.empty() ? "garment" : g.name;
+    for (int k = 2; std::find(used.begin(), used.end(), name) != used.end(); ++k) name = fmt::format("{}_{}", g.name, k);
+    used.push_back(name);
+    Mesh m = g.mesh();
+    m.name = name;
+    add_mesh_node(scene, std::move(m), name);
+  }
+  return scene;
+}
+
+std::string dress_report_json(const Body& body, const DressResult& r, const DressOptions& o) {
+  nlohmann::ordered_json extra;
+  nlohmann::ordered_json garments = nlohmann::ordered_json::array();
+  for (const DressedGarment& g : r.garments) {
+    const StrainStats st = strain_stats(g.model, g.state.x, SpringKind::Structural);
+    const SeamGapStats gaps = seam_gap_stats(g.state.x, g.seam_pairs);
+    nlohmann::ordered_json panels = nlohmann::ordered_json::array();
+    for (const PanelPlacement& p : g.placement)
+      panels.push_back({{"panel", p.panel}, {"region", p.region}, {"clearance_m", p.clearance},
+                        {"vertices_touching_after_growing", p.vertices_touching}});
+    nlohmann::ordered_json stages;
+    for (int s = 0; s < StepProfile::StageCount; ++s)
+      stages[std::string(StepProfile::name(static_cast<StepProfile::Stage>(s)))] = g.profile.seconds[static_cast<size_t>(s)];
+    // Where the widest seam gap is, to find a seam that did not close.
+    nlohmann::ordered_json worst = nullptr;
+    float widest = -1;
+    for (const auto& [a, b] : g.seam_pairs)
+      if (const float gap = (g.state.x[a] - g.state.x[b]).norm(); gap > widest) {
+        widest = gap;
+        const Vec3f mid = 0.5f * (g.state.x[a] + g.state.x[b]);
+        worst = {mid.x(), mid.y(), mid.z()};
+      }
+    garments.push_back({{"name", g.name},
+                        {"size", g.size},
+                        {"fabric", g.fabric},
+                        {"vertices", g.model.particle_count()},
+                        {"springs", g.model.spring_count()},
+                        {"seam_pairs", g.seam_pairs.size()},
+                        {"status", std::string(to_string(g.status))},
+                        {"seams_closed", g.seams_closed},
+                        {"settled", g.settled},
+                        {"initial_max_seam_gap_m", g.initial_max_gap},
+                        {"max_seam_gap_m", gaps.max},
+                        {"mean_seam_gap_m", gaps.mean},
+                        {"widest_seam_gap_at", worst},
+                        {"max_strain", st.max},
+                        {"p99_strain", st.p99},
+                        {"sewing_iterations", g.sewing_iterations},
+                        {"drape_iterations", g.drape_iterations},
+                        {"sewing_wall_seconds", g.sewing_seconds},
+                        {"drape_wall_seconds", g.drape_seconds},
+                        {"simulated_seconds", g.state.time},
+                        {"time_step_s", g.time_step},
+                        {"centre_drop_m", g.drop_m},
+                        {"strain_threshold", g.model.fabric.strain_threshold},
+                        {"panels", panels},
+                        {"stage_seconds", stages}});
+  }
+  extra["garments"] = garments;
+  extra["body"] = {{"vertices", body.mesh.vertex_count()},
+                   {"triangles", body.mesh.triangle_count()},
+                   {"height_m", body.measurements.height}};
+  extra["settings"] = {{"collision", std::string(to_string(o.collision))},
+                       {"mesher", o.mesh.mesher == Mesher::grid ? "grid" : "triangle"},
+                       {"edge_length_m", o.mesh.edge_length},
+                       {"seam_closed_m", o.seam_closed_m},
+                       {"settle_speed_m_per_s", o.settle_speed},
+                       {"settle_window_s", o.settle_window_s},
+                       {"max_iterations", o.max_iterations},
+                       {"penetration_tolerance_m", kPenetrationTolerance}};
+  extra["setup_seconds"] = r.setup_seconds;
+  return report_json(r.quality, r.simulation, r.gates, extra.dump());
+}
+
+void write_dress_outputs(const std::filesystem::path& dir, const Body& body, const DressResult& result,
+                         const DressOptions& options) {
+  // Everything is encoded first, then written, so a failure while encoding leaves nothing behind.
+  const std::vector<unsigned char> glb = encode_glb(dressed_scene(body, result));
+
+  std::vector<Mesh> meshes;
+  for (const DressedGarment& g : result.garments) meshes.push_back(g.mesh());
+  RenderOptions ro;
+  ro.width = 1200;
+  ro.height = 600;
+  std::vector<RenderItem> items{body_item(body.mesh)};
+  for (size_t i = 0; i < meshes.size(); ++i) items.push_back(garment_item(meshes[i], i));
+  const Image shaded = render_views(items, ro);
+  // Second row: structural strain (0 .. threshold + 1 %) on the same views.
+  float threshold = 0.05f;
+  std::vector<RenderItem> strain_items{body_item(body.mesh)};
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const DressedGarment& g = result.garments[i];
+    threshold = g.model.fabric.strain_threshold;
+    const std::vector<float> s = particle_strain(g.model, g.state.x);
+    RenderItem it = garment_item(meshes[i], i);
+    it.vertex_colors = colorize(s, ColorMap::kViridis, 0.0f, threshold + 0.01f);
+    strain_items.push_back(std::move(it));
+  }
+  RenderOptions so = ro;
+  so.legend = Legend{"strain", ColorMap::kViridis, 0.0f, threshold + 0.01f};
+  const Image strain = render_views(strain_items, so);
+  Image both(shaded.width, shaded.height + strain.height);
+  for (int y = 0; y < shaded.height; ++y)
+    std::copy_n(shaded.pixel(0, y), 3 * static_cast<size_t>(shaded.width), both.pixel(0, y));
+  for (int y = 0; y < strain.height; ++y)
+    std::copy_n(strain.pixel(0, y), 3 * static_cast<size_t>(std::min(strain.width, both.width)), both.pixel(0, shaded.height + y));
+  const std::vector<uint8_t> png = encode_png(both);
+  const std::string report = dress_report_json(body, result, options);
+
+  write_file_atomic(dir / "dressed.glb", glb);
+  write_file_atomic(dir / "preview.png", png);
+  write_file_atomic(dir / "report.json", report);
+}
+
+}  // namespace drape

@@ -1,0 +1,30 @@
+#pragma once
+// Internal stages of the dressing pipeline (src/dress), one per file.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/dress.hpp"
+
+namespace drape::dressing {
+
+// Stage 3 (placement.cpp): every panel's vertices rolled around its body region. positions[p][v]
+// is panel p's vertex v in world space; info says where each panel went.
+struct PlacedPanels {
+  std::vector<std::vector<Vec3f>> positions;
+  std::vector<PanelPlacement> info;
+};
+PlacedPanels place_panels(const Body& body, const Garment& garment, const GarmentMesh& mesh,
+                          const Collider& body_collider, float collision_thickness);
+
+// Stage 4 (garment_model.cpp): one cloth spec for all panels (grid topology springs where the
+// grid mesher made the panel, triangle-mesh springs otherwise) and zero-length seam springs.
+struct GarmentCloth {
+  ClothSpec spec;
+  std::vector<std::array<uint32_t, 2>> seam_pairs;
+  std::vector<uint32_t> panel_first_vertex;
+};
+GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh, const PlacedPanels& placed,
+                                const Fabric& fabric);
+
+}  // namespace drape::dressing

@@ -1,0 +1,138 @@
+// Fit metrics on scenes with known answers: a stretched grid, sewn pairs a known distance apart,
+// points inside and outside a sphere; gates and the report.json keys.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "drape/analytic_colliders.hpp"
+#include "drape/cloth.hpp"
+#include "drape/fit.hpp"
+
+namespace drape {
+namespace {
+
+Fabric test_fabric() {
+  const Fabric* f = find_fabric("cotton");
+  return f ? *f : Fabric{};
+}
+
+TEST(SeamGap, MeasuresEveryPair) {
+  const std::vector<Vec3f> x{{0, 0, 0}, {0.003f, 0, 0}, {1, 1, 1}, {1, 1.001f, 1}};
+  const std::vector<std::array<uint32_t, 2>> pairs{{0, 1}, {2, 3}};
+  const SeamGapStats s = seam_gap_stats(x, pairs);
+  EXPECT_EQ(s.pairs, 2u);
+  EXPECT_NEAR(s.max, 0.003f, 1e-6f);
+  EXPECT_NEAR(s.mean, 0.002f, 1e-6f);
+  EXPECT_EQ(seam_gap_stats(x, {}).max, 0.0f);
+}
+
+TEST(MeasureGarment, StrainOfAStretchedGridIsTheStretch) {
+  GridClothOptions o;
+  o.nx = o.ny = 11;
+  o.origin = Vec3f(2, 0.5f, 2);  // far from the sphere below: nothing penetrates
+  const ClothModel model = grid_cloth(test_fabric(), o);
+  std::vector<Vec3f> x = model.rest_position;
+  // 3 % along x (weft): weft springs stretch by 3 %, warp springs keep their length.
+  for (Vec3f& p : x) p.x() = o.origin.x() + 1.03f * (p.x() - o.origin.x());
+  const SphereCollider sphere(Vec3f::Zero(), 0.3f);
+  const InsideTest inside(sphere.mesh());
+  const GarmentMeasure m = measure_garment(model, x, inside);
+  EXPECT_NEAR(m.strain.max, 0.03f, 1e-4f);
+  EXPECT_NEAR(m.strain.min, 0.0f, 1e-4f);
+  EXPECT_EQ(m.penetration.penetrating, 0u);
+  EXPECT_NEAR(m.lowest_y, 0.5f, 1e-6f);
+  EXPECT_TRUE(m.finite);
+  EXPECT_EQ(m.structural_strain.size(), model.range(SpringKind::Structural).size());
+}
+
+TEST(MeasureGarment, PointsInsideASphereArePenetrating) {
+  GridClothOptions o;
+  o.nx = o.ny = 5;
+  o.width = o.height = 0.2f;
+  o.origin = Vec3f(-0.1f, 0.0f, -0.1f);  // through the centre of the sphere
+  const ClothModel model = grid_cloth(test_fabric(), o);
+  std::vector<Vec3f> x = model.rest_position;
+  x[0] = Vec3f(0, 2, 0);  // one point well outside
+  const SphereCollider sphere(Vec3f::Zero(), 0.3f);
+  const InsideTest inside(sphere.mesh());
+  const GarmentMeasure m = measure_garment(model, x, inside);
+  EXPECT_EQ(m.penetration.penetrating, x.size() - 1);
+  EXPECT_NEAR(m.penetration.fraction, static_cast<double>(x.size() - 1) / static_cast<double>(x.size()), 1e-9);
+  // The centre is the deepest point: about the radius (the sphere mesh is a polygon).
+  EXPECT_NEAR(m.penetration.max_depth_m, 0.3f, 0.01f);
+}
+
+TEST(MeasureGarment, NonFiniteStateIsReported) {
+  GridClothOptions o;
+  o.nx = o.ny = 4;
+  const ClothModel model = grid_cloth(test_fabric(), o);
+  std::vector<Vec3f> x = model.rest_position;
+  x[3].y() = std::nanf("");
+  const SphereCollider sphere(Vec3f(5, 5, 5), 0.1f);
+  const InsideTest inside(sphere.mesh());
+  EXPECT_FALSE(measure_garment(model, x, inside).finite);
+}
+
+FitQuality good_quality() {
+  FitQuality q;
+  q.max_strain = 0.05f;
+  q.p99_strain = 0.02f;
+  q.max_seam_gap_m = 0.001f;
+  q.mean_seam_gap_m = 0.0005f;
+  q.settled = true;
+  q.lowest_y = 0.5f;
+  q.vertices = 1000;
+  return q;
+}
+
+TEST(Gates, GoodQualityPassesAndEachFailureIsNamed) {
+  EXPECT_TRUE(all_passed(evaluate_gates(good_quality(), 0.05f)));
+  const auto failed = [](const FitQuality& q) {
+    std::vector<std::string> names;
+    for (const GateResult& g : evaluate_gates(q, 0.05f))
+      if (!g.passed) names.push_back(g.name);
+    return names;
+  };
+  FitQuality q = good_quality();
+  q.max_seam_gap_m = 0.0025f;
+  EXPECT_EQ(failed(q), std::vector<std::string>{"seams_closed"});
+  q = good_quality();
+  q.penetrating_vertices = 6;
+  q.penetration_fraction = 0.006;
+  EXPECT_EQ(failed(q), std::vector<std::string>{"penetration"});
+  q = good_quality();
+  q.max_strain = 0.061f;  // threshold 5 % + 1 %
+  EXPECT_EQ(failed(q), std::vector<std::string>{"strain"});
+  q = good_quality();
+  q.settled = false;
+  EXPECT_EQ(failed(q), std::vector<std::string>{"settled"});
+  q = good_quality();
+  q.lowest_y = -0.01f;
+  EXPECT_EQ(failed(q), std::vector<std::string>{"above_floor"});
+  q = good_quality();
+  q.drop_m = 0.5f;
+  EXPECT_EQ(failed(q), std::vector<std::string>{"stayed_on"});
+}
+
+TEST(Report, QualityHasExactlyTheContractKeys) {
+  FitQuality q = good_quality();
+  q.settled = false;
+  const auto gates = evaluate_gates(q, 0.05f);
+  const nlohmann::json r = nlohmann::json::parse(report_json(q, {120, 4e-4, 0.05, 0.05 / 120}, gates, R"({"extra": 1})"));
+  std::vector<std::string> keys;
+  for (auto it = r["quality"].begin(); it != r["quality"].end(); ++it) keys.push_back(it.key());
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(keys, (std::vector<std::string>{"max_penetration_m", "max_seam_gap_m", "max_strain", "mean_seam_gap_m",
+                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "settled"}));
+  EXPECT_EQ(r["simulation"]["iterations"], 120);
+  EXPECT_TRUE(r["simulation"].contains("time_step_s"));
+  EXPECT_TRUE(r["simulation"].contains("wall_seconds"));
+  EXPECT_TRUE(r["simulation"].contains("seconds_per_iteration"));
+  EXPECT_EQ(r["gates"]["failed"], nlohmann::json::array({"settled"}));
+  EXPECT_FALSE(r["gates"]["passed"].get<bool>());
+  EXPECT_EQ(r["extra"], 1);
+}
+
+}  // namespace
+}  // namespace drape

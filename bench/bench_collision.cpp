@@ -119,7 +119,7 @@ BENCHMARK(BM_InsideTest)->Unit(benchmark::kMillisecond);
 // Table 1, reproduced in spirit: the paper sewed a shirt of 1800 vertices (IS: 82 iterations,
 // 1.3 s, 15.8 ms per iteration; OS: 149 iterations, 4.6 s, 30.8 ms). Until garments are sewn here,
 // a cloth tube of 1800 vertices (60 around x 30 high) around mean_all's waist shrinks by a quarter
-// onto the body (no gravity) until it rests (every vertex slower than 2 cm/s); iterations, total
+// onto the body (no gravity) until it rests (every vertex slower than 5 cm/s, at most 6000 steps); iterations, total
 // time, time per iteration and the final penetration (independent inside test) per method.
 void BM_Table1_TubeShrink(benchmark::State& state, CollisionMethod method) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
@@ -160,9 +160,9 @@ void BM_Table1_TubeShrink(benchmark::State& state, CollisionMethod method) {
   for (auto _ : state) {
     ClothState cloth = initial_state(model);
     const auto start = std::chrono::steady_clock::now();
-    while (cloth.iterations < 20000) {
+    while (cloth.iterations < 6000) {
       if (step(model, cloth, colliders, settings, scratch) != StepStatus::Ok) return state.SkipWithError("simulation failed");
-      if (cloth.iterations > 20 && cloth.max_speed < 0.02f) break;
+      if (cloth.iterations > 20 && cloth.max_speed < 0.05f) break;
     }
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     iterations = cloth.iterations;

@@ -1,0 +1,89 @@
+// `drape dress` as a user runs it: the three output files with DESIGN.md's report keys and a valid
+// GLB; bad input -> exit 2, one stderr line naming the file, nothing written; a run capped so that
+// it cannot settle -> exit 3 with the failed gate in report.json.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "support/gltf_validator.hpp"
+#include "support/test_support.hpp"
+
+namespace drape {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return nlohmann::json::parse(ss.str());
+}
+
+size_t lines(const std::string& s) {
+  size_t n = 0;
+  for (char c : s) n += c == '\n' ? 1 : 0;
+  return n;
+}
+
+TEST(DressCli, DefaultRunWritesTheThreeFiles) {
+  const auto dir = test::temp_dir("dress_default");
+  const auto r = test::run_drape("dress --out " + dir.string());
+  // 0, or 3 while the default shirt does not yet pass every gate (docs/dressing.md, "Status").
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.exit_code << " " << r.err;
+  for (const char* f : {"dressed.glb", "preview.png", "report.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  const nlohmann::json report = read_json(dir / "report.json");
+  std::vector<std::string> keys;
+  for (auto it = report["quality"].begin(); it != report["quality"].end(); ++it) keys.push_back(it.key());
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(keys, (std::vector<std::string>{"max_penetration_m", "max_seam_gap_m", "max_strain", "mean_seam_gap_m",
+                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "settled"}));
+  for (const char* k : {"iterations", "time_step_s", "wall_seconds", "seconds_per_iteration"})
+    EXPECT_TRUE(report["simulation"].contains(k)) << k;
+  EXPECT_EQ(report["gates"]["passed"].get<bool>(), r.exit_code == 0);
+  EXPECT_EQ(report["garments"][0]["name"], "shirt");
+  EXPECT_TRUE(test::gltf_is_valid(dir / "dressed.glb"));
+}
+
+TEST(DressCli, MalformedGarmentIsRefusedAndNothingWritten) {
+  const auto dir = test::temp_dir("dress_bad");
+  const auto garment = dir / "broken.json";
+  std::ofstream(garment) << R"({"drape_garment": 1, "name": "broken", "panels": [)";
+  const auto out = dir / "out";
+  const auto r = test::run_drape("dress --garment " + garment.string() + " --out " + out.string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  EXPECT_NE(r.err.find(garment.string()), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
+  const auto dir = test::temp_dir("dress_bad_size");
+  auto r = test::run_drape("dress --size XXXXL --out " + (dir / "a").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(lines(r.err), 1u) << r.err;
+  r = test::run_drape("dress --body " + (dir / "missing.obj").string() + " --out " + (dir / "b").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing.obj"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+}
+
+TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
+  const auto dir = test::temp_dir("dress_capped");
+  const auto r = test::run_drape("dress --max-iterations 5 --out " + dir.string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  ASSERT_TRUE(std::filesystem::exists(dir / "report.json"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "dressed.glb"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "preview.png"));
+  const nlohmann::json report = read_json(dir / "report.json");
+  EXPECT_FALSE(report["gates"]["passed"].get<bool>());
+  const auto& failed = report["gates"]["failed"];
+  EXPECT_NE(std::find(failed.begin(), failed.end(), "settled"), failed.end()) << failed.dump();
+  EXPECT_NE(std::find(failed.begin(), failed.end(), "seams_closed"), failed.end()) << failed.dump();
+  EXPECT_FALSE(report["quality"]["settled"].get<bool>());
+}
+
+}  // namespace
+}  // namespace drape

@@ -125,7 +125,7 @@ MeasurementRequest parse_measurements(std::string_view text);
 // when the request is not self-consistent enough to build (e.g. waist larger than twice the hips).
 struct BodyBuildOptions {
   float grid_step = 0.011f;  // polygonisation step (metres): ~30k triangles at the default
-  int max_fit_iterations = 6;
+  int max_fit_iterations = 8;
 };
 Body make_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options = {});
 

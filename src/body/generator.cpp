@@ -142,10 +142,10 @@ Model build_model(const Shape& s) {
                                     -0.008f, kTorsoExponent);
   const Ring low = ring_with_girth(0.5f * (hip_y + waist_y), 0.5f * (s.hip_girth + s.waist_girth) + 0.01f, 1.0f,
                                    0.70f, 0.72f, -0.005f, kTorsoExponent);
-  const Ring waist = ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.78f, 0.68f, 0.0f, kTorsoExponent);
+  const Ring waist = ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.68f, 0.68f, 0.0f, kTorsoExponent);
   const Ring underbust = ring_with_girth(underbust_y, s.underbust_girth, 1.0f, 0.72f, 0.72f, -0.005f, kTorsoExponent);
   const float rib_girth = female ? 1.03f * s.underbust_girth : 0.98f * s.chest_girth;
-  const Ring chest = ring_with_girth(bust_y, rib_girth, 1.0f, 0.70f, 0.72f, -0.01f, kTorsoExponent);
+  const Ring chest = ring_with_girth(bust_y, rib_girth, 1.0f, female ? 0.70f : 0.76f, 0.72f, -0.01f, kTorsoExponent);
   const float top_girth = female ? std::max(1.04f * s.underbust_girth, 0.9f * s.chest_girth) : s.chest_girth;
   const Ring armpit = ring_with_girth(armpit_y - 0.015f, top_girth, 1.1f * s.chest_width, 0.62f, 0.68f, -0.015f,
                                       kTorsoExponent);
@@ -168,7 +168,7 @@ Model build_model(const Shape& s) {
   // ---- Shoulder girdle: a loft across the body at acromion height, thicker towards the neck, so the
   // shoulder line slopes from the neck to the arms (trapezius) instead of ending square.
   {
-    const float half = armpit.a + 0.03f;
+    const float half = armpit.a + 0.005f;
     Loft girdle{Vec3f(-half, acromion_y - 0.02f, -0.03f), Vec3f::UnitX(), Vec3f::UnitY(), Vec3f::UnitZ(), 2.0f, {}, 0.04f};
     const float k = H / 1.65f;
     girdle.rings = {Ring{0.0f, 0.036f * k, 0.045f * k, 0.05f * k}, Ring{0.35f * half, 0.04f * k, 0.05f * k, 0.055f * k},

@@ -327,11 +327,12 @@ Landmarks find_landmarks(const Mesh& mesh, const std::string& source) {
     lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
   }
 
-  // Waist: the narrowest torso section between the crotch and the underbust (upper 60 %).
+  // Waist: the narrowest torso section from 30 % to 70 % of the way crotch -> armpit (independent of
+  // the bust and underbust landmarks, which a man's chest or a belly can move).
   {
     float best = 1e9f;
-    const float from = crotch_y + 0.4f * (lm.underbust.y() - crotch_y);
-    for (float y = from; y < lm.underbust.y() - 0.01f; y += 0.003f) {
+    const float from = crotch_y + 0.3f * (low_armpit - crotch_y);
+    for (float y = from; y < crotch_y + 0.7f * (low_armpit - crotch_y); y += 0.003f) {
       auto s = torso_section(mesh, y);
       if (!s) continue;
       const float g = hull_perimeter(s->points);

@@ -68,6 +68,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"sewing_wall_seconds", g.sewing_seconds},
                         {"drape_wall_seconds", g.drape_seconds},
                         {"simulated_seconds", g.state.time},
+                        {"final_max_speed_m_per_s", g.state.max_speed},
                         {"time_step_s", g.time_step},
                         {"centre_drop_m", g.drop_m},
                         {"strain_threshold", g.model.fabric.strain_threshold},

@@ -20,9 +20,12 @@ build: deps configure
 	cmake --build $(BUILD) -j $(JOBS)
 
 # The main job on the embedded defaults: dress the default body, write ./out/.
+# Exit status 3 (quality gates failed) still leaves the outputs: say so loudly, don't hide it.
 demo: build
-	$(BUILD)/drape dress --out out
-	@echo "demo: wrote out/dressed.glb, out/preview.png, out/report.json"
+	@$(BUILD)/drape dress --out out; rc=$$?; \
+	if [ $$rc -eq 0 ]; then echo "demo: wrote out/dressed.glb, out/preview.png, out/report.json"; \
+	elif [ $$rc -eq 3 ]; then echo "demo: wrote out/ but the dressing FAILED quality gates: see gates in out/report.json"; \
+	else exit $$rc; fi
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)

@@ -1,4 +1,5 @@
 #include "body/slicing.hpp"
+#include "geometry/disjoint_sets.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,20 +12,6 @@ SlicePlane horizontal_plane(float height) {
   // normal x u = v: (0,-1,0) x (1,0,0) = (0,0,1).
   return SlicePlane{Vec3f(0, height, 0), Vec3f(0, -1, 0), Vec3f(1, 0, 0)};
 }
-
-namespace {
-
-struct DisjointSets {
-  std::vector<uint32_t> parent;
-  explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  uint32_t find(uint32_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  }
-  void unite(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
-};
-
-}  // namespace
 
 std::vector<SectionPiece> slice(const Mesh& mesh, const SlicePlane& plane) {
   const auto& p = mesh.positions;

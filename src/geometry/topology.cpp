@@ -1,4 +1,5 @@
 #include "geometry/topology.hpp"
+#include "geometry/disjoint_sets.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -98,20 +99,6 @@ void triangulate_polygon(const std::vector<Vec3f>& positions, std::span<const ui
   if (ear_clip(positions, corners, out)) return;
   for (size_t i = 1; i + 1 < n; ++i) out.push_back({corners[0], corners[i], corners[i + 1]});
 }
-
-namespace {
-
-struct DisjointSets {
-  std::vector<uint32_t> parent;
-  explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  uint32_t find(uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
-};
-
-}  // namespace
 
 EdgeTopology edge_topology(const std::vector<Vec3f>& positions, const std::vector<Tri>& triangles) {
   // Weld bit-identical positions: seam copies of a vertex share one id.

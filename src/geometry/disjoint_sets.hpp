@@ -1,0 +1,20 @@
+#pragma once
+// Union-find with path halving, over vertex or triangle indices (topology checks, cross-sections).
+#include <cstddef>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+namespace drape {
+
+struct DisjointSets {
+  std::vector<uint32_t> parent;
+  explicit DisjointSets(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  uint32_t find(uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace drape

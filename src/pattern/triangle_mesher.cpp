@@ -23,6 +23,9 @@ PanelTriangulation triangulate_refined(const BoundaryLoop& boundary, double h) {
   insert_outline(cdt, boundary);
   using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
   CGAL::Delaunay_mesher_no_edge_refinement_2<Cdt, Criteria> mesher(cdt, Criteria(kShapeBound, kLongestEdgeFactor * h));
+  // CGAL 5.5 leaves the mesher's seeds_mark flag uninitialised (UBSan: invalid bool load);
+  // clear_seeds() sets it before refine_mesh() reads it.
+  mesher.clear_seeds();
   mesher.refine_mesh();
   mark_domain(cdt);
   return collect_triangulation(cdt, boundary.points);

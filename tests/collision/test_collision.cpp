@@ -107,7 +107,8 @@ TEST_P(SphereMethods, DistanceAndNormalMatchTheCapsule) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> u(-1, 1);
   int checked = 0;
-  for (int i = 0; i < (sanitized() ? 300 : 3000); ++i) {
+  // Queries are cheap even under sanitizers: keep the full sample so enough points land near the surface.
+  for (int i = 0; i < 3000; ++i) {
     const Vec3f p = centre + Vec3f(0.1f * u(rng), 0.3f * u(rng), 0.1f * u(rng));
     const float exact = test::capsule_distance(p, centre, radius, half_length);
     const bool image = GetParam().method == CollisionMethod::image;

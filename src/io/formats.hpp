@@ -5,10 +5,20 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "drape/io.hpp"
 
 namespace drape::io {
+
+// OBJ and PLY hold one mesh: a scene with that mesh on one root node.
+inline Scene single_mesh_scene(Mesh mesh) {
+  Scene scene;
+  scene.meshes.push_back(std::move(mesh));
+  scene.nodes.push_back(Node{});
+  scene.nodes.back().mesh = 0;
+  return scene;
+}
 
 // Each parser throws InputError(source, ...) on malformed input and fills the counts it alone knows
 // (faces triangulated, faces with fewer than three corners) into `check`.

@@ -263,11 +263,7 @@ Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& che
     }
   }
 
-  Scene scene;
-  scene.meshes.push_back(std::move(mesh));
-  scene.nodes.push_back(Node{});
-  scene.nodes.back().mesh = 0;
-  return scene;
+  return single_mesh_scene(std::move(mesh));
 }
 
 }  // namespace drape::io

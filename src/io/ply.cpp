@@ -335,11 +335,7 @@ Scene parse_ply(std::span<const unsigned char> bytes, const std::string& source,
   for (Vec3f& n : mesh.normals)
     if (n.allFinite() && n.norm() > 0.0f) n.normalize();
 
-  Scene scene;
-  scene.meshes.push_back(std::move(mesh));
-  scene.nodes.push_back(Node{});
-  scene.nodes.back().mesh = 0;
-  return scene;
+  return single_mesh_scene(std::move(mesh));
 }
 
 }  // namespace drape::io

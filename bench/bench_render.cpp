@@ -6,10 +6,10 @@
 
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 
 #include "drape/io.hpp"
 #include "drape/render.hpp"
+#include "drape/shapes.hpp"
 #include "geometry/rasterize.hpp"
 
 namespace {
@@ -18,32 +18,7 @@ using drape::Mesh;
 using drape::Vec3f;
 
 // An ellipsoid 0.45 x 1.75 x 0.3 m standing on the floor: about 50k triangles.
-Mesh standing_ellipsoid() {
-  const int slices = 224, stacks = 112;
-  const float pi = std::numbers::pi_v<float>;
-  Mesh m;
-  const Vec3f radii(0.225f, 0.875f, 0.15f), centre(0, 0.875f, 0);
-  m.positions.push_back(centre + Vec3f(0, radii.y(), 0));
-  for (int i = 1; i < stacks; ++i)
-    for (int j = 0; j < slices; ++j) {
-      const float theta = pi * static_cast<float>(i) / stacks, phi = 2 * pi * static_cast<float>(j) / slices;
-      m.positions.push_back(centre + Vec3f(std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi))
-                                         .cwiseProduct(radii));
-    }
-  m.positions.push_back(centre - Vec3f(0, radii.y(), 0));
-  const auto ring = [&](int i, int j) { return static_cast<uint32_t>(1 + (i - 1) * slices + (j % slices)); };
-  const auto bottom = static_cast<uint32_t>(m.positions.size() - 1);
-  for (int j = 0; j < slices; ++j) {
-    m.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
-    for (int i = 1; i + 1 < stacks; ++i) {
-      m.triangles.push_back({ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)});
-      m.triangles.push_back({ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)});
-    }
-    m.triangles.push_back({ring(stacks - 1, j), bottom, ring(stacks - 1, j + 1)});
-  }
-  m.normals = drape::vertex_normals(m.positions, m.triangles);
-  return m;
-}
+Mesh standing_ellipsoid() { return drape::uv_ellipsoid(Vec3f(0.225f, 0.875f, 0.15f), Vec3f(0, 0.875f, 0), 224, 112); }
 
 Mesh shared_body() {
   const auto path = std::filesystem::path(DRAPE_SHARED_DATA) / "bodies/makehuman/derived/mh_female_average.obj";

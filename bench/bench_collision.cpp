@@ -4,7 +4,9 @@
 // Skips (with a message) when ../shared/data is absent.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <numbers>
 #include <random>
@@ -26,9 +28,12 @@ const Mesh* body() {
   return mesh.positions.empty() ? nullptr : &mesh;
 }
 
-// Cloth-like query points: 50k body vertices pushed along their normals by -5 .. +10 mm, in the
-// body's vertex order (neighbouring queries are near each other, as a cloth's are).
-const std::vector<Vec3f>& cloth_points() {
+// Query points near the skin, pushed along the surface normal by -5 .. +10 mm, 50k of them, two ways:
+// - cloth: uniform over the body's surface area (a garment covers area, not vertices), in rows
+//   (1 cm bands of height, then x), so neighbouring queries are near each other as a cloth's are;
+// - vertices: the body's own vertices in their order: weighted by mesh density, so the hands, face
+//   and feet (fine triangles, hidden from the image maps) get most of them: a worst case.
+const std::vector<Vec3f>& vertex_points() {
   static const std::vector<Vec3f> points = [] {
     std::vector<Vec3f> out;
     const Mesh& m = *body();
@@ -42,17 +47,59 @@ const std::vector<Vec3f>& cloth_points() {
   return points;
 }
 
+const std::vector<Vec3f>& cloth_points() {
+  static const std::vector<Vec3f> points = [] {
+    const Mesh& m = *body();
+    std::vector<double> cumulative_area;
+    double total = 0;
+    for (const Tri& t : m.triangles) {
+      total += 0.5 * static_cast<double>((m.positions[t[1]] - m.positions[t[0]]).cross(m.positions[t[2]] - m.positions[t[0]]).norm());
+      cumulative_area.push_back(total);
+    }
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> offset(-0.005f, 0.010f), unit(0.0f, 1.0f);
+    std::uniform_real_distribution<double> at(0.0, total);
+    std::vector<Vec3f> out;
+    while (out.size() < 50000) {
+      const size_t f = static_cast<size_t>(std::lower_bound(cumulative_area.begin(), cumulative_area.end(), at(rng)) - cumulative_area.begin());
+      const Tri& t = m.triangles[std::min(f, m.triangles.size() - 1)];
+      float a = unit(rng), b = unit(rng);
+      if (a + b > 1) a = 1 - a, b = 1 - b;
+      const Vec3f p0 = m.positions[t[0]], e1 = m.positions[t[1]] - p0, e2 = m.positions[t[2]] - p0;
+      out.push_back(p0 + a * e1 + b * e2 + offset(rng) * e1.cross(e2).normalized());
+    }
+    std::sort(out.begin(), out.end(), [](const Vec3f& p, const Vec3f& q) {
+      const int row_p = static_cast<int>(std::floor(p.y() / 0.01f)), row_q = static_cast<int>(std::floor(q.y() / 0.01f));
+      return row_p != row_q ? row_p < row_q : p.x() < q.x();
+    });
+    return out;
+  }();
+  return points;
+}
+
 constexpr float kQueryRadius = 0.02f;
 
-void BM_Query(benchmark::State& state, CollisionMethod method, bool hidden_handling) {
+// Collision cost per cloth vertex: one query over all points, in blocks of 1024 spread over
+// `threads` OpenMP threads as the simulation's contact stage does (each answer depends only on its
+// point: the same on any thread count). ns_per_vertex is wall time per point.
+void BM_Query(benchmark::State& state, CollisionMethod method, bool hidden_handling, bool on_vertices) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
   BodyColliderOptions options;
   options.hidden_region_handling = hidden_handling;
   const auto collider = make_body_collider(*body(), method, options);
-  const auto& points = cloth_points();
+  const auto& points = on_vertices ? vertex_points() : cloth_points();
+  const int threads = static_cast<int>(state.range(0));
   std::vector<ContactSample> out(points.size());
+  const std::span<const Vec3f> all(points);
+  const std::span<ContactSample> answers(out);
+  constexpr size_t kBlock = 1024;
+  const auto blocks = static_cast<std::ptrdiff_t>((points.size() + kBlock - 1) / kBlock);
   for (auto _ : state) {
-    collider->query(points, kQueryRadius, out);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::ptrdiff_t b = 0; b < blocks; ++b) {
+      const size_t begin = static_cast<size_t>(b) * kBlock, count = std::min(kBlock, points.size() - begin);
+      collider->query(all.subspan(begin, count), kQueryRadius, answers.subspan(begin, count));
+    }
     benchmark::DoNotOptimize(out.data());
   }
   state.SetItemsProcessed(static_cast<int64_t>(state.iterations() * points.size()));
@@ -60,20 +107,26 @@ void BM_Query(benchmark::State& state, CollisionMethod method, bool hidden_handl
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["hidden_fraction"] = collider->build_stats().hidden_fraction;
   state.counters["memory_MB"] = static_cast<double>(collider->build_stats().memory_bytes) / 1e6;
+  state.counters["build_s"] = collider->build_stats().build_seconds;
 }
-BENCHMARK_CAPTURE(BM_Query, image, CollisionMethod::image, true)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Query, image_plain, CollisionMethod::image, false)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Query, bvh, CollisionMethod::bvh, true)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Query, sdf, CollisionMethod::sdf, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, image, CollisionMethod::image, true, false)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, image_plain, CollisionMethod::image, false, false)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, bvh, CollisionMethod::bvh, true, false)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, sdf, CollisionMethod::sdf, true, false)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, image_on_vertices, CollisionMethod::image, true, true)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, image_plain_on_vertices, CollisionMethod::image, false, true)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Query, bvh_on_vertices, CollisionMethod::bvh, true, true)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
-// Embree's rtcPointQuery against the hand-made box BVH, same points, same radius.
-template <class Bvh>
+// The closest-point search alone: Embree's rtcPointQuery, the same with the candidate grid in front
+// (what the bvh method uses for a static body), and the hand-made box BVH; same points, same radius.
+template <class Bvh, bool kGrid = false>
 void BM_ClosestPoint(benchmark::State& state) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
   const collision::BodySurface surface(body()->positions, body()->triangles);
   std::unique_ptr<Bvh> bvh;
   if constexpr (std::is_same_v<Bvh, collision::TriangleBvh>) {
     bvh = std::make_unique<Bvh>(surface, true);
+    if (kGrid) bvh->build_candidate_grid();
   } else {
     bvh = std::make_unique<Bvh>(surface);
   }
@@ -86,6 +139,7 @@ void BM_ClosestPoint(benchmark::State& state) {
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::TriangleBvh)->Name("BM_ClosestPoint/embree")->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::TriangleBvh, true)->Name("BM_ClosestPoint/embree_grid")->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::BoxBvh)->Name("BM_ClosestPoint/box_bvh")->Unit(benchmark::kMillisecond);
 
 // Per frame of a moving body: new vertex positions (a small translation), then maps re-rendered /

@@ -24,14 +24,17 @@ bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactS
 BvhCollider::BvhCollider(const Mesh& body) : surface_(body.positions, body.triangles) {
   const auto start = std::chrono::steady_clock::now();
   bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
+  bvh_->build_candidate_grid();
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats_.memory_bytes = surface_.triangle_count() * 64;  // Embree reports no size: about 64 B per triangle
+  // Embree reports no size: about 64 B per triangle.
+  stats_.memory_bytes = surface_.triangle_count() * 64 + bvh_->candidate_grid()->memory_bytes();
 }
 
 void BvhCollider::set_surface(std::span<const Vec3f> positions, double t) {
   const auto start = std::chrono::steady_clock::now();
   surface_.set_positions(positions, t);
   bvh_->update();
+  stats_.memory_bytes = surface_.triangle_count() * 64;
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

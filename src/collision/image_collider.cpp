@@ -19,6 +19,7 @@ ImageCollider::ImageCollider(const Mesh& body, const BodyColliderOptions& option
   if (!(options.pixel_size > 0)) throw std::invalid_argument("image collider: pixel size must be positive");
   if (options_.hidden_region_handling) {
     bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
+    bvh_->build_candidate_grid();
     reversed_.reserve(surface_.triangle_count());
     for (const Tri& t : surface_.triangles()) reversed_.push_back({t[0], t[2], t[1]});
   }
@@ -34,6 +35,7 @@ void ImageCollider::set_surface(std::span<const Vec3f> positions, double t) {
 void ImageCollider::render_maps() {
   const auto start = std::chrono::steady_clock::now();
   const float h = options_.pixel_size;
+  inverse_pixel_ = 1.0f / h;
   const auto positions = surface_.positions();
   Bounds box;
   for (const Vec3f& p : positions) box.extend(p);
@@ -48,10 +50,19 @@ void ImageCollider::render_maps() {
 
   const size_t pixels = static_cast<size_t>(width_) * static_cast<size_t>(height_);
   texels_.resize(pixels);
-  front_triangle_.assign(front_.triangle.begin(), front_.triangle.end());
-  back_triangle_.assign(back_.triangle.begin(), back_.triangle.end());
   for (size_t p = 0; p < pixels; ++p)
     texels_[p] = {front_.depth[p], back_.depth[p], front_.normal[p], back_.normal[p]};
+
+  // A moving body keeps the visible triangles for the surface velocity.
+  moving_ = std::any_of(surface_.velocities().begin(), surface_.velocities().end(),
+                        [](const Vec3f& v) { return v.squaredNorm() > 0.0f; });
+  if (moving_) {
+    front_triangle_.assign(front_.triangle.begin(), front_.triangle.end());
+    back_triangle_.assign(back_.triangle.begin(), back_.triangle.end());
+  } else {
+    front_triangle_.clear();
+    back_triangle_.clear();
+  }
 
   size_t covered = 0, hidden_covered = 0;
   for (size_t p = 0; p < pixels; ++p) covered += front_.triangle[p] != kNoTriangle;
@@ -97,7 +108,8 @@ void ImageCollider::render_maps() {
       }
   }
   stats_.hidden_fraction = covered ? static_cast<double>(hidden_covered) / static_cast<double>(covered) : 0.0;
-  stats_.memory_bytes = pixels * (sizeof(Texel) + 2 * sizeof(uint32_t));
+  stats_.memory_bytes = pixels * sizeof(Texel) + (front_triangle_.size() + back_triangle_.size()) * sizeof(uint32_t) +
+                        (bvh_ && bvh_->candidate_grid() ? bvh_->candidate_grid()->memory_bytes() : 0);
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -105,7 +117,7 @@ ContactSample ImageCollider::sample(const Vec3f& p, float radius) const {
   const float infinity = std::numeric_limits<float>::infinity();
   ContactSample out{infinity, Vec3f::Zero(), Vec3f::Zero()};
   const float h = options_.pixel_size;
-  const float fi = (p.x() - origin_.x()) / h, fj = (p.y() - origin_.y()) / h;
+  const float fi = (p.x() - origin_.x()) * inverse_pixel_, fj = (p.y() - origin_.y()) * inverse_pixel_;
   if (!(fi >= 0.0f && fj >= 0.0f && fi < static_cast<float>(width_) && fj < static_cast<float>(height_))) return out;
   const int i = static_cast<int>(fi), j = static_cast<int>(fj);
   const size_t pixel = static_cast<size_t>(j) * static_cast<size_t>(width_) + static_cast<size_t>(i);
@@ -131,8 +143,7 @@ ContactSample ImageCollider::sample(const Vec3f& p, float radius) const {
   if (!(distance <= radius)) return out;
   out.distance = distance;
   out.normal = normal;
-  const uint32_t triangle = front ? front_triangle_[pixel] : back_triangle_[pixel];
-  out.velocity = surface_.velocity(surface_.closest_on(triangle, p));
+  if (moving_) out.velocity = surface_.velocity(surface_.closest_on(front ? front_triangle_[pixel] : back_triangle_[pixel], p));
   return out;
 }
 

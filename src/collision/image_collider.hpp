@@ -48,9 +48,13 @@ class ImageCollider final : public BodyCollider {
   BodySurface surface_;
   std::unique_ptr<TriangleBvh> bvh_;  // for hidden pixels; null when handling is off
   int width_ = 0, height_ = 0;
+  float inverse_pixel_ = 1.0f;
   Vec2f origin_ = Vec2f::Zero();
   std::vector<Texel> texels_;
-  std::vector<uint32_t> front_triangle_, back_triangle_;  // visible triangle per pixel (for velocities)
+  // Visible triangle per pixel of each view, for the surface velocity at the query's nearest point
+  // on it; only kept, and only read, while the body moves (a static body's velocity is zero).
+  std::vector<uint32_t> front_triangle_, back_triangle_;
+  bool moving_ = false;
   // Rendering scratch, kept across frames of a moving body.
   DepthNormalMap front_, back_;
   VisibilityBuffer visibility_;

@@ -1,6 +1,7 @@
 // Embree point queries for the nearest body triangle; see triangle_bvh.hpp.
 #include "collision/triangle_bvh.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,19 @@ bool visit_triangle(RTCPointQueryFunctionArguments* args) {
     state->found = true;
     return true;
   }
+  return false;
+}
+
+struct WithinState {
+  const BodySurface* surface;
+  std::vector<uint32_t>* triangles;
+};
+
+// Collects every triangle within the (fixed) query radius.
+bool collect_triangle(RTCPointQueryFunctionArguments* args) {
+  auto* state = static_cast<WithinState*>(args->userPtr);
+  const Vec3f p(args->query->x, args->query->y, args->query->z);
+  if (state->surface->closest_on(args->primID, p).distance <= args->query->radius) state->triangles->push_back(args->primID);
   return false;
 }
 
@@ -67,13 +81,43 @@ void TriangleBvh::upload_vertices() {
 }
 
 void TriangleBvh::update() {
+  grid_.reset();
   upload_vertices();
   rtcUpdateGeometryBuffer(geometry_, RTC_BUFFER_TYPE_VERTEX, 0);
   rtcCommitGeometry(geometry_);
   rtcCommitScene(scene_);
 }
 
+void TriangleBvh::build_candidate_grid(float cell, float band) {
+  grid_.reset();
+  grid_ = std::make_unique<CandidateGrid>(*this, cell, band);
+}
+
 bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
+  if (grid_) {
+    const CandidateGrid::Answer answer = grid_->closest(p, radius, hit);
+    if (answer != CandidateGrid::Answer::kUnknown) return answer == CandidateGrid::Answer::kFound;
+  }
+  return closest_in_tree(p, radius, hit);
+}
+
+void TriangleBvh::within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const {
+  triangles.clear();
+  RTCPointQuery query;
+  query.x = p.x();
+  query.y = p.y();
+  query.z = p.z();
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  WithinState state{&surface_, &triangles};
+  rtcPointQuery(scene_, &query, &context, collect_triangle, &state);
+  std::sort(triangles.begin(), triangles.end());  // a tree may reference a triangle from several leaves
+  triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+}
+
+bool TriangleBvh::closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const {
   RTCPointQuery query;
   query.x = p.x();
   query.y = p.y();

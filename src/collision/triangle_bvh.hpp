@@ -6,9 +6,17 @@
 // measured about 1.7x slower per query on this machine (bench_collision), so the colliders use this. The paper built a quad tree of bounding
 // boxes per scanned body part; Embree's SAH BVH does the same job for any triangle mesh and refits
 // in place when the body moves (RTC_BUILD_QUALITY_REFIT), which is what an animated body needs.
+//
+// Near a static body, queries go first to a CandidateGrid (candidate_grid.hpp): per-cell lists of
+// the triangles that can be nearest, several times faster than the tree descent. A moving body's
+// update() drops the grid (its lists hold for the pose they were built for) and the tree answers.
 #include <embree3/rtcore.h>
 
+#include <memory>
+#include <vector>
+
 #include "collision/body_surface.hpp"
+#include "collision/candidate_grid.hpp"
 
 namespace drape::collision {
 
@@ -21,11 +29,19 @@ class TriangleBvh {
   TriangleBvh(const TriangleBvh&) = delete;
   TriangleBvh& operator=(const TriangleBvh&) = delete;
 
-  // The surface changed pose: refit or rebuild.
+  // The surface changed pose: refit or rebuild; drops the candidate grid.
   void update();
+
+  // Builds the candidate grid for the current pose (cells of `cell` metres within `band` of the surface).
+  void build_candidate_grid(float cell = 0.008f, float band = 0.012f);
+  const CandidateGrid* candidate_grid() const { return grid_.get(); }
 
   // Nearest point of the body to p within `radius`; false when there is none. Thread-safe.
   bool closest(const Vec3f& p, float radius, SurfaceHit& hit) const;
+  // Nearest point through the tree only (no candidate grid).
+  bool closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const;
+  // Every triangle within `radius` of p (cleared first), in the tree's order.
+  void within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const;
 
   const BodySurface& surface() const { return surface_; }
 
@@ -37,6 +53,7 @@ class TriangleBvh {
   RTCScene scene_ = nullptr;
   RTCGeometry geometry_ = nullptr;
   float* vertices_ = nullptr;  // Embree-owned vertex buffer (x, y, z per vertex)
+  std::unique_ptr<CandidateGrid> grid_;
 };
 
 }  // namespace drape::collision

@@ -1,0 +1,57 @@
+#pragma once
+// Exact closest-point queries near a static body in O(1) cells: a uniform grid around the surface
+// where every cell within `band` of it lists the body triangles that can be nearest to some point
+// of the cell, sorted by their distance to the cell centre. The paper's object-space method and
+// most cloth systems of its time (sec. 1: "voxel or octree subdivision") cut space the same way.
+//
+// Why a list per cell and not only a tree: a tree query must descend from the root, and near a
+// curved surface the boxes of many leaves overlap the query sphere (Embree's rtcPointQuery measured
+// about 0.9 us per cloth vertex on a 47.5k-triangle body, the hand-made box BVH 1.4 us). A cell's
+// list answers with a handful of point-triangle tests.
+//
+// Correctness: for a point p in a cell with centre c and half diagonal r, and d_c the distance
+// from c to the body, the nearest triangle T* of p satisfies d(c, T*) <= d(p, T*) + r <= d_c + 2r;
+// the list keeps every triangle with d(c, T) <= d_c + 2r, so it always holds T*. Scanning the list
+// in order of d(c, T) stops once d(c, T) - |p - c| reaches the best distance so far (no later
+// triangle can be nearer). Cells beyond the band store no list: a point there is at least
+// band - r from the body.
+#include <cstdint>
+#include <vector>
+
+#include "collision/body_surface.hpp"
+
+namespace drape::collision {
+
+class TriangleBvh;
+
+class CandidateGrid {
+ public:
+  // Built over the surface's current pose, with the BVH (same pose) answering the build's searches.
+  CandidateGrid(const TriangleBvh& bvh, float cell, float band);
+
+  enum class Answer : uint8_t { kFound, kNone, kUnknown };
+  // kFound: hit is the exact nearest point, within radius. kNone: nothing lies within radius.
+  // kUnknown: p lies outside the listed cells and the radius reaches beyond them: ask the tree.
+  Answer closest(const Vec3f& p, float radius, SurfaceHit& hit) const;
+
+  float band() const { return band_; }
+  size_t memory_bytes() const {
+    return first_.size() * sizeof(uint32_t) + candidates_.size() * sizeof(Candidate);
+  }
+  double mean_list_length() const;
+
+ private:
+  struct Candidate {
+    uint32_t triangle;
+    float centre_distance;  // d(cell centre, triangle)
+  };
+
+  const BodySurface& surface_;
+  float cell_, band_, half_diagonal_;
+  Vec3f origin_ = Vec3f::Zero();
+  uint32_t dims_[3] = {0, 0, 0};
+  std::vector<uint32_t> first_;  // per cell + 1: the cell's candidates are [first_[c], first_[c + 1])
+  std::vector<Candidate> candidates_;
+};
+
+}  // namespace drape::collision

@@ -128,8 +128,8 @@ Model build_model(const Shape& s) {
   const float neck_base_y = 0.845f * H;
   const float acromion_y = neck_base_y - 0.035f * H;
   const float armpit_y = acromion_y - 0.075f * H;
-  const float bust_y = armpit_y - (female ? 0.05f : 0.045f) * H;
-  const float underbust_y = bust_y - 0.045f * H;
+  const float bust_y = armpit_y - (female ? 0.035f : 0.045f) * H;
+  const float underbust_y = bust_y - (female ? 0.05f : 0.045f) * H;
   const float hip_y = s.crotch_y + 0.055f * H;
   const float crotch_y = s.crotch_y;
   const float waist_y = std::clamp(s.waist_y, hip_y + 0.04f, underbust_y - 0.03f);
@@ -140,10 +140,13 @@ Model build_model(const Shape& s) {
   const Ring hip = ring_with_girth(hip_y, s.hip_girth, 1.0f, 0.60f, female ? 0.80f : 0.72f, -0.01f, kTorsoExponent);
   const Ring seat = ring_with_girth(crotch_y + 0.03f, 0.9f * s.hip_girth, 1.0f, 0.58f, female ? 0.74f : 0.68f,
                                     -0.008f, kTorsoExponent);
-  const Ring low = ring_with_girth(0.5f * (hip_y + waist_y), 0.5f * (s.hip_girth + s.waist_girth) + 0.01f, 1.0f,
-                                   0.70f, 0.72f, -0.005f, kTorsoExponent);
-  const Ring waist = ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.68f, 0.68f, 0.0f, kTorsoExponent);
-  const Ring underbust = ring_with_girth(underbust_y, s.underbust_girth, 1.0f, 0.72f, 0.72f, -0.005f, kTorsoExponent);
+  // Between hip and waist: the mean girth and an in-between shape, so nothing bulges between them.
+  const Ring low = ring_with_girth(0.5f * (hip_y + waist_y), 0.5f * (s.hip_girth + s.waist_girth), 1.0f, 0.66f,
+                                   female ? 0.74f : 0.70f, 0.004f, kTorsoExponent);
+  // The waist sits forward of the hips and chest (the lumbar curve): the small of the back is
+  // hollow and the front under the rib cage comes forward again below the bust.
+  const Ring waist = ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.68f, 0.68f, 0.016f * H / 1.65f, kTorsoExponent);
+  const Ring underbust = ring_with_girth(underbust_y, s.underbust_girth, 1.0f, 0.72f, 0.72f, 0.004f, kTorsoExponent);
   const float rib_girth = female ? 1.03f * s.underbust_girth : 0.98f * s.chest_girth;
   const Ring chest = ring_with_girth(bust_y, rib_girth, 1.0f, female ? 0.70f : 0.76f, 0.72f, -0.01f, kTorsoExponent);
   const float top_girth = female ? std::max(1.04f * s.underbust_girth, 0.9f * s.chest_girth) : s.chest_girth;
@@ -179,11 +182,13 @@ Model build_model(const Shape& s) {
 
   // ---- Breasts.
   if (female) {
+    // Their base grows with the rib cage (the underbust girth), not the height.
     const float front = chest.shift + chest.front;
-    const Vec3f radii = Vec3f(0.075f, 0.068f, 0.05f) * (H / 1.65f);
+    const float rib = s.underbust_girth / 0.78f;
+    const Vec3f radii = Vec3f(0.075f, 0.06f, 0.05f) * rib;
     for (float side : {1.0f, -1.0f}) {
-      const Vec3f centre(side * 0.082f * H / 1.65f, bust_y, front + s.bust_protrusion - radii.z());
-      model.add(Ellipsoid{centre, Eigen::Matrix3f::Identity(), radii, 0.05f});
+      const Vec3f centre(side * 0.082f * rib, bust_y, front + s.bust_protrusion - radii.z());
+      model.add(Ellipsoid{centre, Eigen::Matrix3f::Identity(), radii, 0.035f});
     }
   }
 
@@ -294,7 +299,8 @@ Shape initial_shape(Sex sex, const MeasurementRequest& r) {
 void correct(Shape& s, const MeasurementRequest& full, const MeasurementRequest& given, const Measurements& m) {
   // Shoulder width and back length move the chest and waist rings; they are only fitted on request.
   auto wanted = [&](std::string_view key) {
-    return (key != "shoulder_width" && key != "back_length") ? full.count(key) > 0 : given.count(key) > 0;
+    return (key != "shoulder_width" && key != "back_length" && key != "underbust") ? full.count(key) > 0
+                                                                                    : given.count(key) > 0;
   };
   const MeasurementRequest& target = full;
   auto ratio = [&](const char* key, float measured) {
@@ -404,6 +410,9 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
     if (key == "thigh" && given.count("hips")) ratio = given.at("hips") / base.at("hips");
     r[key] = base.at(key) * ratio;
   }
+  // An unrequested underbust stays above the waist: a rib cage narrower than the belly would move
+  // the waist (the narrowest section) up under the chest.
+  if (!given.count("underbust")) r["underbust"] = std::max(r.at("underbust"), std::min(r.at("bust"), r.at("waist") + 0.02f));
   if (r.at("underbust") > r.at("bust"))
     throw InputError("--measurements", "underbust is larger than bust");
   if (r.at("waist") > 1.5f * r.at("hips") || r.at("hips") > 2.2f * r.at("waist"))
@@ -431,10 +440,16 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
   Body body;
   body.sex = sex;
   shape = best_shape;
+  best_error = std::numeric_limits<float>::max();
   for (int pass = 0; pass < 2; ++pass) {
-    body.mesh = polygonise_model(build_model(shape), options.grid_step);
-    const Measurements m = measure_body(body.mesh, find_landmarks(body.mesh, "generated body"));
-    if (worst_error(given, m) < 0.004f) break;
+    Mesh mesh = polygonise_model(build_model(shape), options.grid_step);
+    const Measurements m = measure_body(mesh, find_landmarks(mesh, "generated body"));
+    const float error = worst_error(given, m);
+    if (error < best_error) {
+      best_error = error;
+      body.mesh = std::move(mesh);
+    }
+    if (error < 0.004f) break;
     correct(shape, r, given, m);
   }
   body.mesh.name = "body";

@@ -127,24 +127,11 @@ TEST(BodyFromMeasurements, SizesXsToXxlMeasureBackWithinOneCentimetre) {
     const MeasurementRequest request{{"height", size.height}, {"bust", size.bust}, {"waist", size.waist}, {"hips", size.hips}};
     const Body body = make_body(size.sex, request, options);
     for (const auto& [key, value] : request) {
-      // Known gaps (see DISABLED_BustWithinOneCentimetre): the bust of most female sizes and the male
-      // XXL waist do not converge yet; they are checked within 12 cm / 3 cm only.
-      const bool gap = key == "bust" || (key == "waist" && size.name == std::string("male XXL"));
       const auto& table = measurement_table();
       const auto row = std::find_if(table.begin(), table.end(), [&](const MeasurementInfo& r) { return r.key == key; });
-      EXPECT_NEAR(body.measurements.*(row->field), value, gap ? (key == "bust" ? 0.12f : 0.03f) : 0.01f)
-          << size.name << " " << key;
+      EXPECT_NEAR(body.measurements.*(row->field), value, 0.01f) << size.name << " " << key;
     }
     expect_valid_body(body, size.name);
-  }
-}
-
-// Known to fail: female bust off by 3-10 cm for XS-L (the breasts' protrusion control saturates).
-TEST(BodyFromMeasurements, DISABLED_BustWithinOneCentimetre) {
-  for (const Size& size : sizes()) {
-    const Body body = make_body(size.sex, {{"height", size.height}, {"bust", size.bust}, {"waist", size.waist}, {"hips", size.hips}});
-    EXPECT_NEAR(body.measurements.bust, size.bust, 0.01f) << size.name;
-    EXPECT_NEAR(body.measurements.waist, size.waist, 0.01f) << size.name;
   }
 }
 
@@ -175,6 +162,16 @@ TEST(BodyFromMeasurements, DefaultBodiesAreAverageAdults) {
   EXPECT_NEAR(female.measurements.height, 1.65f, 0.01f);
   EXPECT_NEAR(male.measurements.height, 1.78f, 0.01f);
   EXPECT_GT(male.measurements.shoulder_width, female.measurements.shoulder_width);
+  // The defaults are made from the average measurements (all but shoulder width and back length,
+  // which follow from the rest): each measures back within 1 cm.
+  for (const Body* body : {&female, &male}) {
+    for (const auto& [key, value] : default_measurements(body->sex)) {
+      if (key == "shoulder_width" || key == "back_length") continue;
+      const auto& table = measurement_table();
+      const auto row = std::find_if(table.begin(), table.end(), [&](const MeasurementInfo& r) { return r.key == key; });
+      EXPECT_NEAR(body->measurements.*(row->field), value, 0.01f) << (body == &female ? "female " : "male ") << key;
+    }
+  }
   // The glTF scene: a `body` node with a skin over named joints.
   const Scene scene = body_scene(female);
   const int node = scene.find_node("body");

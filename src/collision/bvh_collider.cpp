@@ -15,8 +15,15 @@ bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactS
     return false;
   }
   const BodySurface& surface = bvh.surface();
-  out.distance = surface.sign(hit, p) * hit.distance;
+  const float sign = surface.sign(hit, p);
+  out.distance = sign * hit.distance;
   out.normal = surface.smooth_normal(hit);
+  // Away from the surface, the way out is along p - nearest point; the interpolated normal can point
+  // elsewhere at a crease (the top of a narrow gap), which would push the cloth into the other wall.
+  if (hit.distance > 1e-3f) {
+    const Vec3f out_direction = sign * (p - hit.where.point) / hit.distance;
+    if (out_direction.dot(out.normal) < 0.7f) out.normal = out_direction;
+  }
   out.velocity = surface.velocity(hit);
   return true;
 }

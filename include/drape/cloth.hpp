@@ -159,6 +159,21 @@ struct StepSettings {
   StrainLimit strain_limit = StrainLimit::Velocity;
   float strain_threshold = 0.05f;  // fraction of rest length
   int strain_passes = 2;           // maximum Gauss-Seidel passes per step (1: the paper; 2 measured enough)
+  // With Velocity limiting: Provot position-modification passes after the position update (0: none),
+  // which pull back springs that velocity modification alone leaves past the threshold (it only
+  // stops further stretching), e.g. where seam forces or contacts pulled them.
+  int position_passes = 0;
+  // Viscous damping -gamma m v (1/s, sec. 2.2); negative: the fabric's air_damping. Quasi-static
+  // draping raises it: the rest shape does not depend on it, only how fast the cloth gets there.
+  float air_damping = -1.0f;
+  // Particle pairs held together (sewn seams, sec. 6.2): in every strain-limit pass, after the
+  // springs, each pair's ends get one velocity that closes their gap within the step (velocity
+  // passes) and are moved to their mass-weighted mean (position passes). Pairs may share particles
+  // (seams meeting at a corner); they run in the given order, on one thread.
+  std::span<const std::array<uint32_t, 2>> joined_pairs{};
+  // Coulomb coefficient of the velocity contact response; negative: the fabric's. (Sewing puts a
+  // garment on with frictionless contact, as a tailor slides it into place.)
+  float friction = -1.0f;
   // Velocity: eq. 5 with Coulomb friction, relative to the surface velocity, for static and slowly
   // moving bodies. Force: sec. 5's response for animated bodies, a force along the surface normal
   // proportional to the depth inside the collision thickness.

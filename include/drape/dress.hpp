@@ -32,15 +32,24 @@ struct DressOptions {
   CollisionMethod collision = CollisionMethod::image;
   MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
   std::string fabric;  // empty: each garment's own
-  // Sewing: seam springs pull the pairs together with gravity off until every pair is closer
-  // than `seam_closed_m`, for at most `max_sewing_seconds` of simulated time.
-  float seam_closed_m = 0.0015f;
+  // Sewing: seam springs pull the pairs together with gravity off and frictionless contact; a pair
+  // closer than `seam_closed_m` is joined (held together from then on); sewing ends when every pair
+  // is joined, or after `max_sewing_seconds` of simulated time.
+  float seam_closed_m = 0.005f;
   double max_sewing_seconds = 1.5;
-  // Draping: gravity on until settled, for at most `max_drape_seconds`.
+  // Draping: gravity on until settled, for at most `max_drape_seconds`, with viscous damping
+  // `drape_damping` (1/s; quasi-static draping: it changes how fast the rest shape is reached, not
+  // the rest shape).
   double max_drape_seconds = 2.0;
-  // Settled: every vertex slower than `settle_speed` for `settle_window_s` consecutive seconds.
-  float settle_speed = 0.05f;      // m/s
-  double settle_window_s = 0.05;   // s
+  float drape_damping = 4.0f;
+  // Settled: the garment's mass-weighted RMS speed sqrt(2 E_kin / M) below `settle_speed` for
+  // `settle_window_s` consecutive seconds of simulated time.
+  float settle_speed = 0.01f;      // m/s
+  double settle_window_s = 0.1;    // s
+  // Strain limiting per step: velocity-modification passes (sec. 3.3), then Provot
+  // position-modification passes that pull back what seam holds and contacts stretched.
+  int strain_passes = 4;
+  int position_passes = 4;
   // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
   uint64_t max_iterations = 0;
   // false: stop after placement (to inspect where the panels start); the run is not settled.
@@ -62,6 +71,8 @@ struct DressedGarment {
   ClothModel model;
   ClothState state;
   std::vector<std::array<uint32_t, 2>> seam_pairs;  // particle pairs sewn together
+  std::vector<uint32_t> seam_of_pair;               // per pair: index into seam_names
+  std::vector<std::string> seam_names;              // the garment's seams, in file order
   std::vector<uint32_t> panel_first_vertex;         // particle range of each panel (+ end)
   std::vector<std::string> panel_names;
   std::vector<PanelPlacement> placement;

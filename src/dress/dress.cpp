@@ -20,6 +20,8 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   g.model = compile(std::move(cloth.spec));
   g.state = initial_state(g.model);
   g.seam_pairs = std::move(cloth.seam_pairs);
+  g.seam_of_pair = std::move(cloth.seam_of_pair);
+  for (const SeamSpec& s : garment.seams) g.seam_names.push_back(s.name);
   g.panel_first_vertex = std::move(cloth.panel_first_vertex);
   for (const Panel& p : garment.panels) g.panel_names.push_back(p.name);
   g.placement = std::move(placed.info);

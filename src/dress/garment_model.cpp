@@ -99,14 +99,20 @@ GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh,
   constexpr float kSewingRate = 60.0f;
   double total_mass = 0;
   for (float m : spec.mass) total_mass += m;
+  // Pairs that share a vertex twice (corners where two seams meet) are kept once, with the seam
+  // that listed them first.
+  std::vector<std::array<uint32_t, 3>> pairs;  // a, b, seam
   for (const SeamVertexPair& pair : mesh.seam_pairs) {
     const uint32_t a = out.panel_first_vertex[pair.panel_a] + pair.vertex_a;
     const uint32_t b = out.panel_first_vertex[pair.panel_b] + pair.vertex_b;
-    if (a != b) out.seam_pairs.push_back({a, b});
+    if (a != b) pairs.push_back({std::min(a, b), std::max(a, b), pair.seam});
   }
-  // Pairs that share a vertex twice (corners where two seams meet) are kept once.
-  std::sort(out.seam_pairs.begin(), out.seam_pairs.end());
-  out.seam_pairs.erase(std::unique(out.seam_pairs.begin(), out.seam_pairs.end()), out.seam_pairs.end());
+  std::sort(pairs.begin(), pairs.end());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (i > 0 && pairs[i][0] == pairs[i - 1][0] && pairs[i][1] == pairs[i - 1][1]) continue;
+    out.seam_pairs.push_back({pairs[i][0], pairs[i][1]});
+    out.seam_of_pair.push_back(pairs[i][2]);
+  }
   const float k_seam = out.seam_pairs.empty() ? 0.0f
       : static_cast<float>(kSewingRate * kSewingRate * total_mass / static_cast<double>(out.seam_pairs.size()));
   for (const auto& [a, b] : out.seam_pairs) spec.springs.push_back({a, b, 0.0f, k_seam, SpringKind::Seam});

@@ -48,6 +48,15 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
         const Vec3f mid = 0.5f * (g.state.x[a] + g.state.x[b]);
         worst = {mid.x(), mid.y(), mid.z()};
       }
+    // The widest gap of every seam.
+    std::vector<float> seam_gap(g.seam_names.size(), 0.0f);
+    for (size_t i = 0; i < g.seam_pairs.size() && i < g.seam_of_pair.size(); ++i) {
+      const auto [a, b] = g.seam_pairs[i];
+      float& widest_of_seam = seam_gap.at(g.seam_of_pair[i]);
+      widest_of_seam = std::max(widest_of_seam, (g.state.x[a] - g.state.x[b]).norm());
+    }
+    nlohmann::ordered_json seams = nlohmann::ordered_json::array();
+    for (size_t i = 0; i < seam_gap.size(); ++i) seams.push_back({{"seam", g.seam_names[i]}, {"max_gap_m", seam_gap[i]}});
     garments.push_back({{"name", g.name},
                         {"size", g.size},
                         {"fabric", g.fabric},
@@ -61,6 +70,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"max_seam_gap_m", gaps.max},
                         {"mean_seam_gap_m", gaps.mean},
                         {"widest_seam_gap_at", worst},
+                        {"seams", seams},
                         {"max_strain", st.max},
                         {"p99_strain", st.p99},
                         {"sewing_iterations", g.sewing_iterations},

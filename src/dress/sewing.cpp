@@ -2,16 +2,20 @@
 // lines. After a certain number of iterations the patterns are seamed ... Then several more
 // iterations are performed applying gravity in order to drape the cloth."
 //
-// Sewing: gravity off, body collision on, the zero-length seam springs pull every pair together.
-// After each step the seams get the paper's velocity modification (sec. 3.3) with a rest length of
-// 0: a pair may close but never open, and never close faster than its gap in one step, so pairs do
-// not overshoot through each other (the cloth core limits only springs with a positive rest length,
-// so this kernel lives here). Sewing ends when every pair is closer than seam_closed_m.
-// Draping: gravity on; the seam springs stay (they are never welded, so the seam gap in the
-// report is a real distance). Settled: every vertex slower than settle_speed for settle_window_s
-// of simulated time in a row.
+// Sewing: gravity off, body collision on with frictionless contact (the panels slide into place as
+// a garment does when put on), the zero-length seam springs pull every pair together. After each
+// step the seams get the paper's velocity modification (sec. 3.3) with a rest length of 0: a pair
+// may close but never open, and never close faster than its gap in one step. A pair that comes
+// within seam_closed_m is joined ("seamed"): from then on the step holds its two particles together
+// (StepSettings::joined_pairs, solved in the same Gauss-Seidel passes as the strain limit). The
+// particles stay distinct, so the seam gap in the report is the real distance between them.
+// Sewing ends when every pair is joined.
+// Draping: gravity on, the fabric's friction, viscous damping raised for quasi-static draping.
+// Settled: the mass-weighted RMS speed stays below settle_speed for settle_window_s of simulated
+// time (a few corner vertices may still tremble; the garment as a whole is at rest).
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "drape/dress.hpp"
 
@@ -49,11 +53,32 @@ Vec3f centre_of_mass(const ClothModel& m, const std::vector<Vec3f>& x) {
   return total > 0 ? Vec3f(c / static_cast<float>(total)) : c;
 }
 
+// Joined pairs (sec. 6.2, "the patterns are seamed"): a pair whose seam forces brought it within
+// `closed` is joined, and from then on the step holds its two particles together (StepSettings::
+// joined_pairs: one velocity, one position, solved with the strain limit). Newly closed pairs are
+// added to `held` in pair order; returns whether every pair is joined.
+bool join_closed_pairs(const ClothState& state, std::span<const std::array<uint32_t, 2>> pairs,
+                       std::vector<uint8_t>& joined, std::vector<std::array<uint32_t, 2>>& held, float closed) {
+  bool all = true, changed = false;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!joined[i] && (state.x[pairs[i][0]] - state.x[pairs[i][1]]).norm() <= closed) joined[i] = changed = true;
+    all = all && joined[i];
+  }
+  if (changed) {
+    held.clear();
+    for (size_t i = 0; i < pairs.size(); ++i)
+      if (joined[i]) held.push_back(pairs[i]);
+  }
+  return all;
+}
+
 }  // namespace
 
 void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, const DressOptions& o,
                    const DressProgressCallback& progress, size_t index, size_t count) {
   StepSettings settings = default_step_settings(g.model);
+  settings.strain_passes = o.strain_passes;
+  settings.position_passes = o.position_passes;
   const float dt = g.model.stable_time_step();
   settings.time_step = dt;
   g.time_step = dt;
@@ -70,12 +95,18 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   // Sewing: no gravity until every pair is closed.
   auto start = std::chrono::steady_clock::now();
   settings.gravity = Vec3f::Zero();
-  g.seams_closed = g.seam_pairs.empty();
+  settings.friction = 0.0f;
+  std::vector<uint8_t> joined(g.seam_pairs.size(), 0);
+  std::vector<std::array<uint32_t, 2>> held;
+  held.reserve(g.seam_pairs.size());
+  g.seams_closed = join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
+  settings.joined_pairs = held;
   while (!g.seams_closed && g.state.time < o.max_sewing_seconds && g.state.iterations < cap) {
     g.status = step(g.model, g.state, colliders, settings, scratch, &g.profile);
     if (g.status != StepStatus::Ok) break;
     limit_seams(g.model, g.state, g.seam_pairs, dt);
-    g.seams_closed = seam_gap() <= o.seam_closed_m;
+    g.seams_closed = join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
+    settings.joined_pairs = held;
     report("sewing", o.max_sewing_seconds);
   }
   g.sewing_iterations = g.state.iterations;
@@ -84,7 +115,10 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   // Draping: gravity until every vertex has been slow for the settle window.
   start = std::chrono::steady_clock::now();
   settings.gravity = Vec3f(0.0f, -9.81f, 0.0f);
+  settings.friction = -1.0f;
+  settings.air_damping = o.drape_damping;
   const Vec3f before = centre_of_mass(g.model, g.state.x);
+  const double total_mass = g.model.total_mass();
   const double drape_start = g.state.time;
   double calm_since = -1;
   g.settled = false;
@@ -92,7 +126,10 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     g.status = step(g.model, g.state, colliders, settings, scratch, &g.profile);
     if (g.status != StepStatus::Ok) break;
     limit_seams(g.model, g.state, g.seam_pairs, dt);
-    if (g.state.max_speed < o.settle_speed) {
+    join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
+    settings.joined_pairs = held;
+    const double rms_speed = std::sqrt(2.0 * g.state.kinetic_energy / total_mass);
+    if (rms_speed < o.settle_speed) {
       if (calm_since < 0) calm_since = g.state.time;
       if (g.state.time - calm_since >= o.settle_window_s) {
         g.settled = true;

@@ -22,6 +22,7 @@ PlacedPanels place_panels(const Body& body, const Garment& garment, const Garmen
 struct GarmentCloth {
   ClothSpec spec;
   std::vector<std::array<uint32_t, 2>> seam_pairs;
+  std::vector<uint32_t> seam_of_pair;  // per pair: the garment's seam index
   std::vector<uint32_t> panel_first_vertex;
 };
 GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh, const PlacedPanels& placed,

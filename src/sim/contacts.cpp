@@ -44,7 +44,7 @@ uint64_t respond_to_contacts(const StepContext& c) {
   ContactSample* contact = c.scratch.contact.data();
   const float* w = m.inverse_mass.data();
   const Fabric& f = m.fabric;
-  const float dt = c.dt;
+  const float dt = c.dt, friction = c.settings.friction >= 0 ? c.settings.friction : f.friction;
   uint64_t contacts = 0;
   const std::ptrdiff_t blocks = static_cast<std::ptrdiff_t>(block_count(m.particle_count()));
 #pragma omp parallel for schedule(static) reduction(+ : contacts) if (blocks >= kMinParallelBlocks)
@@ -54,7 +54,7 @@ uint64_t respond_to_contacts(const StepContext& c) {
       ContactSample& s = contact[i];
       if (w[i] == 0 || !(s.distance < std::numeric_limits<float>::infinity())) continue;
       contacts += respond_contact_velocity(x[i], v[i], s.distance, s.normal, s.velocity, f.collision_thickness,
-                                           f.friction, f.restitution, dt)
+                                           friction, f.restitution, dt)
                       ? 1u
                       : 0u;
       // A particle put back on the thickness layer is now at the thickness (a second call is velocity-only).

@@ -39,7 +39,8 @@ void integrate_velocities(const StepContext& c) {
   const float* inv_mass = m.inverse_mass.data();
   const float* area = m.drag_area.data();
   const Vec3f g = c.settings.gravity;
-  const float dt = c.dt, gamma = m.fabric.air_damping, drag = m.fabric.air_drag;
+  const float dt = c.dt, drag = m.fabric.air_drag;
+  const float gamma = c.settings.air_damping >= 0 ? c.settings.air_damping : m.fabric.air_damping;
   parallel_blocks(m.particle_count(), [&](size_t, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       Vec3f f = Vec3f::Zero();

@@ -66,6 +66,31 @@ inline bool limit_spring_position(Vec3f& xa, Vec3f& xb, float wa, float wb, floa
   return excess > tolerance;
 }
 
+// A joined pair (a sewn seam): both ends get their mass-weighted mean velocity plus the share of
+// -gap/dt that closes the gap at the end of the step (velocity pass), or both move to their
+// mass-weighted mean position (position pass). Momentum is kept. Returns true if it changed
+// something by more than `tolerance` (m, over the step).
+inline bool hold_pair_velocity(const Vec3f& xa, const Vec3f& xb, Vec3f& va, Vec3f& vb, float wa, float wb, float dt,
+                               float tolerance) {
+  const float w = wa + wb;
+  if (w <= 0) return false;
+  const Vec3f closing = (xa + dt * va) - (xb + dt * vb);  // gap at the end of the step
+  if (closing.norm() <= tolerance) return false;
+  const Vec3f change = closing / (dt * w);
+  va -= wa * change;
+  vb += wb * change;
+  return true;
+}
+inline bool hold_pair_position(Vec3f& xa, Vec3f& xb, float wa, float wb, float tolerance) {
+  const float w = wa + wb;
+  if (w <= 0) return false;
+  const Vec3f d = xa - xb;
+  if (d.norm() <= tolerance) return false;
+  xa -= (wa / w) * d;
+  xb += (wb / w) * d;
+  return true;
+}
+
 // Collision response by velocity (eq. 5, v = C_fric v_t - C_refl v_n) for one particle whose
 // nearest surface is `distance` away along `normal`, moving with `surface_velocity`. Contact when
 // the particle would end the step closer than `thickness`. A particle already inside the thickness

@@ -10,7 +10,8 @@
 //   limit strain          velocity modification, sec. 3.3, each pass followed by
 //                         the contact response (velocities only)          [Velocity limit]
 //   integrate positions   eq. 3
-//   limit strain          position modification, Provot / sec. 3.2         [Position limit]
+//   limit strain          position modification, Provot / sec. 3.2         [Position limit, or
+//                         position_passes after velocity modification]
 //   check health          NaN / explosion: reported, sticky, never hidden
 #include <chrono>
 #include <stdexcept>
@@ -134,7 +135,16 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
   }
   sim::integrate_positions(c);
   clock.mark(StepProfile::IntegratePositions);
-  if (settings.strain_limit == StrainLimit::Position) limited = sim::limit_strain_position(c);
+  if (settings.strain_limit == StrainLimit::Position) {
+    limited = sim::limit_strain_position(c, settings.strain_passes);
+  } else if (settings.strain_limit == StrainLimit::Velocity && settings.position_passes > 0) {
+    // Clean-up of what the velocity passes left (springs already past the threshold stay there
+    // under velocity modification alone): counted with the velocity passes.
+    const sim::StrainLimitResult cleanup = sim::limit_strain_position(c, settings.position_passes);
+    limited.passes += cleanup.passes;
+    limited.corrections += cleanup.corrections;
+    limited.at_pass_limit = limited.at_pass_limit || cleanup.at_pass_limit;
+  }
   clock.mark(StepProfile::LimitStrainPosition);
   state.status = sim::check_health(c);
   clock.mark(StepProfile::CheckHealth);

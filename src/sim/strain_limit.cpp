@@ -3,6 +3,8 @@
 //   are, or would become, longer than (1 + threshold) rest lose the stretching part of their ends'
 //   relative velocity. Position modification (Provot 1995, the paper's sec. 3.2 baseline): after the
 //   position update, over-long springs have their ends moved together.
+// Joined pairs (StepSettings::joined_pairs, sewn seams) are held together in the same passes, after
+// the springs, in their given order on one thread (they may share particles at seam corners).
 // Both run Gauss-Seidel passes over the model's spring colours: the springs of one colour share no
 // particle, so a colour runs in parallel without races, and colours run in a fixed order, so the
 // result is the same on any number of threads. With velocity-response contacts, every velocity pass
@@ -19,13 +21,14 @@ namespace drape::sim {
 namespace {
 
 constexpr float kRelativeTolerance = 1e-4f;
+constexpr float kJoinedTolerance = 1e-5f;  // m: a joined pair this close counts as held
 
-template <class Kernel, class AfterPass>
-StrainLimitResult run_passes(const StepContext& c, Kernel&& kernel, AfterPass&& after_pass) {
+template <class Kernel, class Hold, class AfterPass>
+StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kernel, Hold&& hold, AfterPass&& after_pass) {
   const ClothModel& m = c.model;
   StrainLimitResult result;
   const size_t colours = m.limit_colour_begin.empty() ? 0 : m.limit_colour_begin.size() - 1;
-  for (int pass = 0; pass < c.settings.strain_passes; ++pass) {
+  for (int pass = 0; pass < max_passes; ++pass) {
     uint64_t corrections = 0;
     for (size_t colour = 0; colour < colours; ++colour) {
       const size_t first = m.limit_colour_begin[colour], count = m.limit_colour_begin[colour + 1] - first;
@@ -37,6 +40,7 @@ StrainLimitResult run_passes(const StepContext& c, Kernel&& kernel, AfterPass&& 
         for (size_t s = begin; s < end; ++s) corrections += kernel(s) ? 1u : 0u;
       }
     }
+    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
     if (corrections > 0) after_pass();  // nothing changed: nothing to answer
     ++result.passes;
     result.corrections += corrections;
@@ -54,25 +58,27 @@ StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contac
   Vec3f* v = c.state.v.data();
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold, dt = c.dt;
-  return run_passes(c, [&](size_t s) {
+  return run_passes(c, c.settings.strain_passes, [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
     return limit_spring_velocity(x[a], x[b], v[a], v[b], w[a], w[b], stretch * rest, dt, kRelativeTolerance * rest);
+  }, [&](uint32_t a, uint32_t b) {
+    return hold_pair_velocity(x[a], x[b], v[a], v[b], w[a], w[b], dt, kJoinedTolerance);
   }, [&] {
     if (answer_contacts) respond_to_contacts(c);
   });
 }
 
-StrainLimitResult limit_strain_position(const StepContext& c) {
+StrainLimitResult limit_strain_position(const StepContext& c, int max_passes) {
   const ClothModel& m = c.model;
   Vec3f* x = c.state.x.data();
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold;
-  return run_passes(c, [&](size_t s) {
+  return run_passes(c, max_passes, [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
     return limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest);
-  }, [] {});
+  }, [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); }, [] {});
 }
 
 }  // namespace drape::sim

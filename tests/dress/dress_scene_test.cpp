@@ -68,11 +68,15 @@ TEST(DressScene, DefaultShirtOnDefaultBodyIsSound) {
   expect_sound(dress(cached_body(Sex::Female), {{load_garment(default_garment_name()), ""}}));
 }
 
-// NOT YET REACHED (see docs/dressing.md, "Status"): the default shirt still ends with a shoulder
-// or underarm seam pair about 2 cm apart, a peak strain of ~15 % next to it, and a few vertices
-// that keep the cloth from meeting the settle criterion. Enable when the gates pass.
-TEST(DressScene, DISABLED_DefaultShirtOnDefaultBodyPassesTheGates) {
+TEST(DressScene, DefaultShirtOnDefaultBodyPassesTheGates) {
   expect_dressed(cached_body(Sex::Female), default_garment_name(), "");
+}
+
+// The shirt's other sizes on the default (female) body. NOT YET on the male body: its shoulders
+// and neck are wider than the pattern's (the shoulder seams stay ~2-3 cm open), see docs/dressing.md.
+TEST(DressScene, ShirtOtherSizesOnDefaultBody) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  for (const char* size : {"S", "L"}) expect_dressed(cached_body(Sex::Female), "shirt", size);
 }
 
 class EveryBuiltin : public ::testing::TestWithParam<std::string> {};

@@ -1,5 +1,7 @@
 // `drape body`: a body from measurements (drape's parametric generator; no data files), written as a
 // rigged GLB/glTF (or OBJ/PLY without the rig). Prints the requested and measured values as JSON.
+#include <cmath>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -32,13 +34,24 @@ void run_body(const BodyArgs& args) {
   j["vertices"] = body.mesh.vertex_count();
   j["triangles"] = body.mesh.triangle_count();
   j["joints"] = body.skeleton.joints.size();
+  // Keys the generator could only fit approximately (more than 1 cm off: a combination the body
+  // shape cannot reach, see docs/bodies.md) are flagged in the report and named on stderr.
+  std::string approximate;
   for (const auto& row : measurement_table()) {
     const std::string key(row.key);
-    nlohmann::json entry{{"measured_m", body.measurements.*row.field}};
-    if (const auto it = request.find(key); it != request.end()) entry["requested_m"] = it->second;
+    const float measured = body.measurements.*row.field;
+    nlohmann::json entry{{"measured_m", measured}};
+    if (const auto it = request.find(key); it != request.end()) {
+      entry["requested_m"] = it->second;
+      entry["within_1cm"] = std::abs(measured - it->second) <= 0.01f;
+      if (!entry["within_1cm"].get<bool>())
+        approximate += fmt::format("{}{} {:.1f} cm (requested {:.1f})", approximate.empty() ? "" : ", ", key,
+                                   100 * measured, 100 * it->second);
+    }
     j["measurements"][key] = entry;
   }
   fmt::print("{}\n", j.dump(2));
+  if (!approximate.empty()) fmt::print(stderr, "drape: body: fitted approximately: {}\n", approximate);
 }
 
 }  // namespace

@@ -69,7 +69,7 @@ struct Shape {
   float waist_y = 1.0f;
   float hip_girth = 0.99f, waist_girth = 0.74f, underbust_girth = 0.78f, chest_girth = 0.92f;
   float bust_protrusion = 0.03f;  // women: how far the breasts stand out of the rib cage
-  float chest_width = 1.0f;       // scales the chest ring's width against its depth
+  float shoulder_offset = 0.0f;   // moves the shoulder joints out (+) or in from the chest's side
   float neck_radius = 0.053f;
   float thigh_girth = 0.57f, upper_arm_girth = 0.28f, wrist_girth = 0.155f;
   float arm_scale = 1.0f;
@@ -150,7 +150,7 @@ Model build_model(const Shape& s) {
   const float rib_girth = female ? 1.03f * s.underbust_girth : 0.98f * s.chest_girth;
   const Ring chest = ring_with_girth(bust_y, rib_girth, 1.0f, female ? 0.70f : 0.76f, 0.72f, -0.01f, kTorsoExponent);
   const float top_girth = female ? std::max(1.04f * s.underbust_girth, 0.9f * s.chest_girth) : s.chest_girth;
-  const Ring armpit = ring_with_girth(armpit_y - 0.015f, top_girth, 1.1f * s.chest_width, 0.62f, 0.68f, -0.015f,
+  const Ring armpit = ring_with_girth(armpit_y - 0.015f, top_girth, 1.1f, 0.62f, 0.68f, -0.015f,
                                       kTorsoExponent);
   const float rn = s.neck_radius;
   torso.rings = {
@@ -171,7 +171,7 @@ Model build_model(const Shape& s) {
   // ---- Shoulder girdle: a loft across the body at acromion height, thicker towards the neck, so the
   // shoulder line slopes from the neck to the arms (trapezius) instead of ending square.
   {
-    const float half = armpit.a + 0.005f;
+    const float half = armpit.a + std::max(0.0f, s.shoulder_offset) + 0.005f;
     Loft girdle{Vec3f(-half, acromion_y - 0.02f, -0.03f), Vec3f::UnitX(), Vec3f::UnitY(), Vec3f::UnitZ(), 2.0f, {}, 0.04f};
     const float k = H / 1.65f;
     girdle.rings = {Ring{0.0f, 0.036f * k, 0.045f * k, 0.05f * k}, Ring{0.35f * half, 0.04f * k, 0.05f * k, 0.055f * k},
@@ -207,10 +207,10 @@ Model build_model(const Shape& s) {
                       Vec3f(0.008f, 0.017f, 0.011f) * H, 0.012f});
 
   // ---- Legs: from the hip joints to the ankles, slightly apart (A-pose stance).
-  const float thigh_r = s.thigh_girth / (2 * kPi);
-  // Thighs a little narrower side to side than front to back; their outer sides continue the hips
-  // and a small gap is left between them at the crotch.
-  const float leg_x = std::max(0.9f * thigh_r + 0.006f, hip.a - 0.95f * thigh_r);
+  // Thighs narrower side to side than front to back; their outer sides stay inside the hips (so the
+  // hip ring, not the thighs, sets the hip girth) and a small gap is left between them at the crotch.
+  const float thigh_half_width = ring_with_girth(0.0f, s.thigh_girth, 0.82f, 1.0f, 1.08f, 0.0f, 2.0f).a;
+  const float leg_x = std::max(thigh_half_width + 0.008f, hip.a - 1.05f * thigh_half_width);
   const float ankle_y = 0.065f * H;
   const float knee_y = ankle_y + 0.57f * (crotch_y - ankle_y);
   for (float side : {1.0f, -1.0f}) {
@@ -222,8 +222,8 @@ Model build_model(const Shape& s) {
     auto t_at = [&](float y) { return (top.y() - y) / -axis.y(); };
     const float T = s.thigh_girth;
     leg.rings = {
-        ring_with_girth(0.0f, 0.85f * T, 0.95f, 1.0f, 1.1f, 0.0f, 2.0f),
-        ring_with_girth(t_at(crotch_y - 0.02f), T, 0.92f, 1.0f, 1.08f, 0.0f, 2.0f),
+        ring_with_girth(0.0f, 0.85f * T, 0.85f, 1.0f, 1.1f, 0.0f, 2.0f),
+        ring_with_girth(t_at(crotch_y - 0.02f), T, 0.82f, 1.0f, 1.08f, 0.0f, 2.0f),
         ring_with_girth(t_at(0.5f * (crotch_y + knee_y)), 0.82f * T, 1.0f, 1.0f, 1.05f, 0.0f, 2.0f),
         ring_with_girth(t_at(knee_y + 0.04f), 0.64f * T, 1.0f, 1.0f, 0.95f, 0.0f, 2.0f),
         ring_with_girth(t_at(knee_y - 0.02f), 0.62f * T, 1.0f, 0.95f, 1.0f, -0.005f, 2.0f),
@@ -247,7 +247,7 @@ Model build_model(const Shape& s) {
   const float hand_len = 0.108f * H;
   const float c45 = std::sqrt(0.5f);
   for (float side : {1.0f, -1.0f}) {
-    const Vec3f joint(side * (armpit.a + 0.75f * top_r), armpit_y + 0.75f * top_r, armpit.shift);
+    const Vec3f joint(side * (armpit.a + 0.75f * top_r + s.shoulder_offset), armpit_y + 0.75f * top_r, armpit.shift);
     const Vec3f axis(side * c45, -c45, 0.0f);
     const Vec3f lateral = Vec3f::UnitZ().cross(axis).normalized() * side;
     Loft arm{joint, axis, lateral, Vec3f::UnitZ(), 2.0f, {}, 0.03f};
@@ -255,8 +255,9 @@ Model build_model(const Shape& s) {
     arm.rings = {
         ring_with_girth(0.0f, 2 * kPi * top_r, 1.0f, 1.0f, 1.0f, 0.0f, 2.0f),
         ring_with_girth(0.5f * upper_len, U, 1.0f, 1.0f, 1.05f, 0.0f, 2.0f),
-        ring_with_girth(upper_len, 0.8f * U, 1.0f, 1.0f, 1.0f, 0.0f, 2.0f),
-        ring_with_girth(upper_len + 0.3f * fore_len, 0.87f * U, 0.95f, 1.0f, 1.0f, 0.0f, 2.0f),
+        // The elbow and forearm stay fuller than the wrist, so the wrist remains the narrowest section.
+        ring_with_girth(upper_len, std::max(0.8f * U, 1.2f * W), 1.0f, 1.0f, 1.0f, 0.0f, 2.0f),
+        ring_with_girth(upper_len + 0.3f * fore_len, std::max(0.87f * U, 1.3f * W), 0.95f, 1.0f, 1.0f, 0.0f, 2.0f),
         ring_with_girth(upper_len + fore_len, W, 0.75f, 1.0f, 1.0f, 0.0f, 2.0f),
         ring_with_girth(upper_len + fore_len + 0.02f, 1.05f * W, 0.7f, 1.0f, 1.0f, 0.0f, 2.0f),
     };
@@ -311,7 +312,7 @@ void correct(Shape& s, const MeasurementRequest& full, const MeasurementRequest&
   };
   s.neck_radius *= ratio("neck", m.neck);
   if (s.sex == Sex::Female) {
-    s.bust_protrusion = std::max(0.002f, s.bust_protrusion + 0.5f * shift("bust", m.bust));
+    s.bust_protrusion = std::max(0.002f, s.bust_protrusion + 0.3f * shift("bust", m.bust));
   } else {
     s.chest_girth *= ratio("bust", m.bust);
   }
@@ -323,7 +324,10 @@ void correct(Shape& s, const MeasurementRequest& full, const MeasurementRequest&
   s.wrist_girth *= ratio("wrist", m.wrist);
   s.crotch_y += shift("inseam", m.inseam);
   s.arm_scale *= ratio("arm_length", m.arm_length);
-  s.chest_width *= ratio("shoulder_width", m.shoulder_width);
+  // Both shoulders move. Narrower than the chest allows would push the arms into the torso: the
+  // shoulders come in by at most a quarter of the deltoid's radius.
+  s.shoulder_offset = std::max(s.shoulder_offset + shift("shoulder_width", m.shoulder_width),
+                               -0.25f * 1.2f * s.upper_arm_girth / (2 * kPi));
   s.waist_y -= 0.7f * shift("back_length", m.back_length);
 }
 

@@ -135,21 +135,28 @@ TEST(BodyFromMeasurements, SizesXsToXxlMeasureBackWithinOneCentimetre) {
   }
 }
 
-// Known to fail (bust, underbust, thigh, inseam off by 2-8 cm when every key is requested at once:
-// the controls interact); kept here, disabled, as the next target for the generator.
-TEST(BodyFromMeasurements, DISABLED_AllKeysAtOnce) {
+// Every key at once (the controls interact: shoulder width moves the arms, the rib cage moves the
+// bust, ...), for a small woman, an average woman and an average man.
+TEST(BodyFromMeasurements, AllKeysAtOnce) {
   if (sanitized()) GTEST_SKIP() << "slow under sanitizers";
   BodyBuildOptions options;
   options.grid_step = 0.014f;
-  const MeasurementRequest request = parse_measurements(
-      "height=1.70,neck=0.34,bust=0.94,underbust=0.80,waist=0.76,hips=1.00,thigh=0.58,upper_arm=0.29,"
-      "wrist=0.16,inseam=0.77,arm_length=0.57");
-  const Body body = make_body(Sex::Female, request, options);
-  for (const auto& row : measurement_table()) {
-    const auto it = request.find(row.key);
-    if (it != request.end()) {
-      EXPECT_NEAR(body.measurements.*row.field, it->second, 0.01f) << row.key;
-    }
+  const std::vector<std::pair<Sex, const char*>> requests{
+      {Sex::Female,
+       "height=1.60,neck=0.32,bust=0.80,underbust=0.68,waist=0.62,hips=0.86,thigh=0.50,upper_arm=0.24,"
+       "wrist=0.145,inseam=0.72,arm_length=0.53,shoulder_width=0.35,back_length=0.39"},
+      {Sex::Female,
+       "height=1.70,neck=0.34,bust=0.94,underbust=0.80,waist=0.76,hips=1.00,thigh=0.58,upper_arm=0.29,"
+       "wrist=0.16,inseam=0.77,arm_length=0.57,shoulder_width=0.37,back_length=0.41"},
+      {Sex::Male,
+       "height=1.80,neck=0.40,bust=1.02,underbust=0.92,waist=0.88,hips=1.00,thigh=0.58,upper_arm=0.32,"
+       "wrist=0.18,inseam=0.83,arm_length=0.61,shoulder_width=0.42,back_length=0.46"}};
+  for (const auto& [sex, text] : requests) {
+    const MeasurementRequest request = parse_measurements(text);
+    ASSERT_EQ(request.size(), measurement_table().size());
+    const Body body = make_body(sex, request, options);
+    for (const auto& row : measurement_table())
+      EXPECT_NEAR(body.measurements.*row.field, request.at(std::string(row.key)), 0.01f) << row.key << " of " << text;
   }
 }
 

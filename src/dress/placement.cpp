@@ -15,7 +15,10 @@
 // body is placed again with 1 cm more clearance (up to 4 cm more), and vertices still inside are
 // pushed out along the collider normal.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <numbers>
 
 #include "dress/stages.hpp"
@@ -114,6 +117,7 @@ bool in_region(BodyPart part, BodyRegion r) {
 struct Section {
   Vec3f centre = Vec3f::Zero();
   float a = 0.1f, b = 0.1f;
+  float body_b = 0.0f;  // the body's half depth here (no clearance)
   std::vector<float> arc;  // arc length at angle index k of kAngles (phi from front towards side)
   float perimeter() const { return arc.back(); }
 };
@@ -152,51 +156,65 @@ float side_angle(PanelSide side) {
   return 0.0f;
 }
 
-struct RegionPanels {
-  BodyRegion region;
-  std::vector<size_t> panels;
+// Arc length from the front (phi = 0) to angle phi on a section.
+float arc_at(const Section& c, float phi) {
+  float f = phi / (2 * kPi) * kAngles;
+  f = std::fmod(f, static_cast<float>(kAngles));
+  if (f < 0) f += kAngles;
+  const size_t k = std::min(static_cast<size_t>(f), static_cast<size_t>(kAngles) - 1);
+  const float w = f - static_cast<float>(k);
+  return (1 - w) * c.arc[k] + w * c.arc[k + 1];
+}
+
+// One lofted surface: a section at every station t_min + s * kStation along an axis.
+struct Stack {
+  Axis axis;
+  Vec3f side_dir = Vec3f::UnitX();
+  float t_min = 0;
+  std::vector<Section> sec;
+
+  int stations() const { return static_cast<int>(sec.size()); }
+  float t_of(int s) const { return t_min + kStation * static_cast<float>(s); }
+  float t_max() const { return t_of(stations() - 1); }
+  int station_of(float t) const {
+    return std::clamp(static_cast<int>(std::lround((t - t_min) / kStation)), 0, stations() - 1);
+  }
+  Vec3f on(const Section& c, float t, float phi_c, float s) const {
+    const float phi = angle_at(c, arc_at(c, phi_c) + s);
+    const Vec3f centre = c.centre + (t - (c.centre - axis.origin).dot(axis.up)) * axis.up;
+    return centre + c.a * std::sin(phi) * side_dir + c.b * std::cos(phi) * axis.front;
+  }
+  // The point at height t, `s` metres of arc from the line at angle phi_c (sections interpolated).
+  Vec3f point(float t, float phi_c, float s) const {
+    if (stations() == 1) return on(sec[0], t, phi_c, s);
+    const float f = std::clamp((t - t_min) / kStation, 0.0f, static_cast<float>(stations() - 1));
+    const int i = std::min(static_cast<int>(f), stations() - 2);
+    const float w = f - static_cast<float>(i);
+    return (1 - w) * on(sec[static_cast<size_t>(i)], t, phi_c, s) + w * on(sec[static_cast<size_t>(i) + 1], t, phi_c, s);
+  }
 };
 
-// Places the panels of one region at `extra` metres beyond their clearance.
-void place_region(const Body& body, const Garment& garment, const GarmentMesh& mesh, const RegionPanels& rp,
-                  float extra, PlacedPanels& out) {
-  const Axis axis = region_axis(body, rp.region);
-  const Vec3f side_dir = axis.up.cross(axis.front);  // u x front: the body's left for the torso
-  const auto station_t = [&](const Vec3f& p) { return (p - axis.origin).dot(axis.up); };
-
-  // Panel vertex heights along the axis: anchor at the landmark's station.
-  std::vector<std::vector<float>> vt(rp.panels.size());
-  float t_min = std::numeric_limits<float>::max(), t_max = -t_min, clearance = 0;
-  for (size_t k = 0; k < rp.panels.size(); ++k) {
-    const size_t p = rp.panels[k];
-    const PlacementHint& h = *garment.panels[p].placement;
-    // Panels hung from the shoulders or neck start a little high, so their shoulder seams close
-    // over the shoulders instead of having to climb them; gravity lowers them while draping.
-    const bool hung = rp.region == BodyRegion::torso && (h.landmark == Landmark::shoulder || h.landmark == Landmark::neck);
-    const float t_anchor = station_t(landmark_point(body.landmarks, h.landmark, rp.region)) + (hung ? kShoulderLift : 0.0f);
-    clearance = std::max(clearance, static_cast<float>(h.clearance));
-    for (const Vec3f& q : mesh.panels[p].mesh.positions) {
-      vt[k].push_back(t_anchor + (q.y() - static_cast<float>(h.anchor.y())));
-      t_min = std::min(t_min, vt[k].back());
-      t_max = std::max(t_max, vt[k].back());
-    }
-  }
-  clearance += extra;
-  const int stations = std::max(1, static_cast<int>(std::ceil((t_max - t_min) / kStation)) + 1);
-  const auto station_of = [&](float t) {
-    return std::clamp(static_cast<int>(std::lround((t - t_min) / kStation)), 0, stations - 1);
-  };
+// The body's sections of the vertices `in` accepts (those below t_cut left out), a running maximum
+// over 3 cm so bumps are cleared, plus the clearance, scaled up where `needed` (arc per station)
+// is longer than the perimeter, then a running mean so the surface has gentle slopes.
+template <class InSurface>
+Stack build_stack(const Body& body, InSurface in, const Axis& axis, float t_min, int stations, float clearance,
+                  const std::vector<float>& needed, bool circles, float t_cut) {
+  Stack st;
+  st.axis = axis;
+  st.side_dir = axis.up.cross(axis.front);  // u x front: the body's left for the torso
+  st.t_min = t_min;
+  st.sec.resize(static_cast<size_t>(stations));
+  const size_t n = static_cast<size_t>(stations);
 
   // Body extent per station, in the axis frame (across = side_dir, depth = front).
-  std::vector<Bounds> extent(static_cast<size_t>(stations));
+  std::vector<Bounds> extent(n);
   for (size_t i = 0; i < body.mesh.positions.size(); ++i) {
-    if (!in_region(body.parts[i], rp.region)) continue;
+    if (!in(body.parts[i])) continue;
     const Vec3f d = body.mesh.positions[i] - axis.origin;
     const float t = d.dot(axis.up);
-    if (t < t_min - kStation || t > t_max + kStation) continue;
-    // The foot is not part of the leg's tube (the leg axis starts at the ankle).
-    if ((rp.region == BodyRegion::left_leg || rp.region == BodyRegion::right_leg) && t < 0.0f) continue;
-    extent[static_cast<size_t>(station_of(t))].extend(Vec3f(d.dot(side_dir), d.dot(axis.front), 0.0f));
+    if (t < t_cut || t < t_min - kStation || t > st.t_max() + kStation) continue;
+    extent[static_cast<size_t>(st.station_of(t))].extend(Vec3f(d.dot(st.side_dir), d.dot(axis.front), 0.0f));
   }
   // Stations without body (above a limb's end, below the body) copy their nearest neighbour.
   for (int pass = 0; pass < 2; ++pass)
@@ -207,26 +225,9 @@ void place_region(const Body& body, const Garment& garment, const GarmentMesh& m
         extent[static_cast<size_t>(to)] = extent[static_cast<size_t>(from)];
     }
 
-  // Panel arc widths per station, to size the ellipse so the region's panels fit side by side.
-  std::vector<float> needed(static_cast<size_t>(stations), 0.0f);
-  for (size_t k = 0; k < rp.panels.size(); ++k) {
-    std::vector<Vec2f> range(static_cast<size_t>(stations), Vec2f(1e9f, -1e9f));
-    const auto& q = mesh.panels[rp.panels[k]].mesh.positions;
-    for (size_t v = 0; v < q.size(); ++v) {
-      Vec2f& r = range[static_cast<size_t>(station_of(vt[k][v]))];
-      r = Vec2f(std::min(r.x(), q[v].x()), std::max(r.y(), q[v].y()));
-    }
-    for (int s = 0; s < stations; ++s) {
-      const Vec2f r = range[static_cast<size_t>(s)];
-      if (r.y() >= r.x()) needed[static_cast<size_t>(s)] += (r.y() - r.x()) + 2 * kPanelGap;
-    }
-  }
-
-  // Sections: the body's ellipse (a running maximum over 3 cm, so bumps are cleared) plus the
-  // clearance, scaled up where the panels need more room.
   constexpr int kSmooth = 6;
-  std::vector<Section> sec(static_cast<size_t>(stations));
-  std::vector<float> scale(static_cast<size_t>(stations), 1.0f);
+  std::vector<Section>& sec = st.sec;
+  std::vector<float> scale(n, 1.0f);
   for (int s = 0; s < stations; ++s) {
     Bounds e;
     for (int j = std::max(0, s - kSmooth); j <= std::min(stations - 1, s + kSmooth); ++j)
@@ -237,15 +238,16 @@ void place_region(const Body& body, const Garment& garment, const GarmentMesh& m
     Section& c = sec[static_cast<size_t>(s)];
     const Vec3f ctr = e.empty() ? Vec3f::Zero() : e.center();
     const Vec3f half = e.empty() ? Vec3f(0.1f, 0.1f, 0) : Vec3f(0.5f * e.size());
-    c.centre = axis.origin + (t_min + kStation * static_cast<float>(s)) * axis.up + ctr.x() * side_dir + ctr.y() * axis.front;
-    if (is_limb(rp.region)) {  // limbs: circles
+    c.centre = axis.origin + st.t_of(s) * axis.up + ctr.x() * st.side_dir + ctr.y() * axis.front;
+    c.body_b = half.y();
+    if (circles) {
       c.a = c.b = std::max(half.x(), half.y()) + clearance;
     } else {
       c.a = half.x() + clearance;
       c.b = half.y() + clearance;
     }
     build_arc(c);
-    scale[static_cast<size_t>(s)] = std::max(1.0f, needed[static_cast<size_t>(s)] / c.perimeter());
+    if (!needed.empty()) scale[static_cast<size_t>(s)] = std::max(1.0f, needed[static_cast<size_t>(s)] / c.perimeter());
   }
   // The scale is smoothed (running maximum) so the surface has no steps.
   for (int s = 0; s < stations; ++s) {
@@ -258,60 +260,346 @@ void place_region(const Body& body, const Garment& garment, const GarmentMesh& m
       build_arc(c);
     }
   }
+  // A running mean over the same window turns the running maxima's steps into gentle slopes; it
+  // stays outside the body, as every maximum it averages covers this station.
+  std::vector<Section> smooth = sec;
+  for (int s = 0; s < stations; ++s) {
+    float a = 0, b = 0, body_b = 0;
+    Vec3f c = Vec3f::Zero();
+    int count = 0;
+    for (int j = std::max(0, s - kSmooth); j <= std::min(stations - 1, s + kSmooth); ++j, ++count) {
+      a += sec[static_cast<size_t>(j)].a;
+      b += sec[static_cast<size_t>(j)].b;
+      body_b = std::max(body_b, sec[static_cast<size_t>(j)].body_b);
+      c += sec[static_cast<size_t>(j)].centre - kStation * static_cast<float>(j - s) * axis.up;
+    }
+    Section& t = smooth[static_cast<size_t>(s)];
+    t.a = a / static_cast<float>(count);
+    t.b = b / static_cast<float>(count);
+    t.body_b = body_b;
+    t.centre = c / static_cast<float>(count);
+    build_arc(t);
+  }
+  sec = std::move(smooth);
+  return st;
+}
+
+// Where one panel goes: x -> arc from the line at phi_c on `surface`, flat y -> distance along the
+// surface from the anchor's station. A trouser panel (a leg panel hung from the waist or hips) is
+// blended: on the torso's surface above the hips, on its leg's below the crotch, a smooth mix
+// between (both surfaces share one station grid).
+struct PanelMap {
+  const Stack* surface = nullptr;
+  float phi_c = 0, x0 = 0;
+  const Stack* leg = nullptr;
+  float leg_phi_c = 0, leg_x0 = 0;
+  float blend_lo = 0, blend_hi = 0;  // torso weight 0 below blend_lo, 1 above blend_hi
+  float t_anchor = 0, y_anchor = 0;
+
+  Vec3f at(float x, float t) const {
+    const Vec3f p = surface->point(t, phi_c, x - x0);
+    if (!leg || t >= blend_hi) return p;
+    const Vec3f q = leg->point(t, leg_phi_c, x - leg_x0);
+    if (t <= blend_lo) return q;
+    const float f = (t - blend_lo) / (blend_hi - blend_lo);
+    const float w = f * f * (3 - 2 * f);  // smoothstep
+    return w * p + (1 - w) * q;
+  }
+};
+
+// Rolls a panel with its map. The flat y distance becomes distance along the surface (measured
+// where the surface is steepest across the panel), so no column of the panel is stretched;
+// rolling along each section is isometric and a blend of two isometric rolls never stretches.
+void roll_panel(const PanelMap& m, const std::vector<Vec3f>& q, bool along_surface, std::vector<Vec3f>& x) {
+  const Stack& st = *m.surface;
+  x.resize(q.size());
+  if (!along_surface) {  // flat y is height
+    for (size_t v = 0; v < q.size(); ++v) x[v] = m.at(q[v].x(), m.t_anchor + (q[v].y() - m.y_anchor));
+    return;
+  }
+  const int stations = st.stations();
+  float x_lo = std::numeric_limits<float>::max(), x_hi = -x_lo;
+  for (const Vec3f& p : q) {
+    x_lo = std::min(x_lo, p.x());
+    x_hi = std::max(x_hi, p.x());
+  }
+  // The panel's x range per station at its nominal height (widened by a station each way).
+  std::vector<Vec2f> range(static_cast<size_t>(stations), Vec2f(x_hi, x_lo));
+  for (const Vec3f& p : q) {
+    const int s0 = st.station_of(m.t_anchor + (p.y() - m.y_anchor));
+    for (int s = std::max(0, s0 - 1); s <= std::min(stations - 1, s0 + 1); ++s) {
+      Vec2f& r = range[static_cast<size_t>(s)];
+      r = Vec2f(std::min(r.x(), p.x()), std::max(r.y(), p.x()));
+    }
+  }
+  // Cumulative length along the surface, station by station.
+  constexpr int kSamples = 16;
+  std::vector<float> along(static_cast<size_t>(stations), 0.0f);
+  for (int s = 0; s + 1 < stations; ++s) {
+    Vec2f r = range[static_cast<size_t>(s)];
+    if (r.y() < r.x()) r = Vec2f(x_lo, x_hi);
+    float step = kStation;
+    for (int j = 0; j <= kSamples; ++j) {
+      const float xs = r.x() + (r.y() - r.x()) * static_cast<float>(j) / kSamples;
+      step = std::max(step, (m.at(xs, st.t_of(s + 1)) - m.at(xs, st.t_of(s))).norm());
+    }
+    along[static_cast<size_t>(s) + 1] = along[static_cast<size_t>(s)] + step;
+  }
+  const auto along_at = [&](float t) {
+    const float f = std::clamp((t - st.t_min) / kStation, 0.0f, static_cast<float>(stations - 1));
+    const int i = std::min(static_cast<int>(f), std::max(0, stations - 2));
+    const float w = f - static_cast<float>(i);
+    return stations == 1 ? 0.0f : (1 - w) * along[static_cast<size_t>(i)] + w * along[static_cast<size_t>(i) + 1];
+  };
+  const float anchor_along = along_at(m.t_anchor);
+  for (size_t v = 0; v < q.size(); ++v) {
+    const float target = anchor_along + (q[v].y() - m.y_anchor);
+    const auto it = std::lower_bound(along.begin(), along.end(), target);
+    float t = st.t_min;
+    if (it == along.end()) {
+      t = st.t_max();
+    } else if (it != along.begin()) {
+      const size_t k = static_cast<size_t>(it - along.begin());
+      const float a0 = along[k - 1], a1 = along[k];
+      t = st.t_of(static_cast<int>(k) - 1) + kStation * (a1 > a0 ? (target - a0) / (a1 - a0) : 0.0f);
+    }
+    x[v] = m.at(q[v].x(), t);
+  }
+}
+
+// A trouser panel: a leg panel anchored at the waist, the hips or the crotch, so it covers the
+// torso above the crotch and its leg below.
+bool spans_hips(const PlacementHint& h) {
+  return (h.body_part == BodyRegion::left_leg || h.body_part == BodyRegion::right_leg) &&
+         (h.landmark == Landmark::waist || h.landmark == Landmark::hip || h.landmark == Landmark::crotch);
+}
+
+// How far below the waist a garment's waistband sits: where the body's girth (the ellipse around
+// its torso section, arms left out) first reaches the band's girth less 2 cm, at most 15 cm down.
+// The band is the top 3 cm of every panel (a back panel's top rises towards the centre), side by side.
+float waistband_drop(const Body& body, const Garment& garment, const GarmentMesh& mesh, const std::vector<size_t>& panels) {
+  constexpr float kBand = 0.03f, kEase = 0.02f, kMaxDrop = 0.15f;
+  float band = 0;
+  for (size_t p : panels) {
+    if (garment.panels[p].placement->landmark != Landmark::waist) return 0.0f;
+    const auto& q = mesh.panels[p].mesh.positions;
+    float top = -std::numeric_limits<float>::max();
+    for (const Vec3f& v : q) top = std::max(top, v.y());
+    float lo = std::numeric_limits<float>::max(), hi = -lo;
+    for (const Vec3f& v : q)
+      if (v.y() >= top - kBand) {
+        lo = std::min(lo, v.x());
+        hi = std::max(hi, v.x());
+      }
+    band += std::max(0.0f, hi - lo);
+  }
+  const float waist = body.landmarks.waist.y();
+  const int steps = static_cast<int>(kMaxDrop / kStation);
+  std::vector<Bounds> section(static_cast<size_t>(steps) + 1);
+  for (size_t i = 0; i < body.mesh.positions.size(); ++i) {
+    const Vec3f& p = body.mesh.positions[i];
+    const int s = static_cast<int>(std::lround((waist - p.y()) / kStation));
+    if (s >= 0 && s <= steps && in_region(body.parts[i], BodyRegion::torso)) section[static_cast<size_t>(s)].extend(p);
+  }
+  for (int s = 0; s <= steps; ++s) {
+    const Bounds& b = section[static_cast<size_t>(s)];
+    if (b.empty()) continue;
+    const float a = 0.5f * b.size().x(), c = 0.5f * b.size().z();
+    const float girth = kPi * (3 * (a + c) - std::sqrt((3 * a + c) * (a + 3 * c)));  // Ramanujan
+    if (girth >= band - kEase) return kStation * static_cast<float>(s);
+  }
+  return kMaxDrop;
+}
+
+struct RegionPanels {
+  BodyRegion region;
+  bool trousers = false;  // the leg panels that span the hips, placed together
+  std::vector<size_t> panels;
+};
+
+// Whether the body vertex nearest to p belongs to a part the region does not wrap (an arm next to
+// a torso panel): the region's surface is not grown for it, the cloth slides off it when sewn.
+bool near_other_part(const Body& body, const Vec3f& p, const RegionPanels& rp) {
+  size_t best = 0;
+  float best_d = std::numeric_limits<float>::max();
+  for (size_t i = 0; i < body.mesh.positions.size(); ++i) {
+    const float d = (body.mesh.positions[i] - p).squaredNorm();
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
+  }
+  const BodyPart part = body.parts[best];
+  if (rp.trousers) return part == BodyPart::LeftArm || part == BodyPart::RightArm;
+  return !in_region(part, rp.region);
+}
+
+// Places the panels of one region at `extra` metres beyond their clearance.
+void place_region(const Body& body, const Garment& garment, const GarmentMesh& mesh, const RegionPanels& rp,
+                  float extra, PlacedPanels& out) {
+  // Trousers use the torso's vertical axis for every surface, so torso and legs share stations.
+  const Axis axis = rp.trousers ? Axis{} : region_axis(body, rp.region);
+  const auto station_t = [&](const Vec3f& p) { return (p - axis.origin).dot(axis.up); };
+
+  // Panel vertex heights along the axis (nominal: flat distance from the anchor).
+  std::vector<std::vector<float>> vt(rp.panels.size());
+  std::vector<float> t_anchor(rp.panels.size());
+  float t_lo = std::numeric_limits<float>::max(), t_hi = -t_lo, clearance = 0;
+  for (size_t k = 0; k < rp.panels.size(); ++k) {
+    const size_t p = rp.panels[k];
+    const PlacementHint& h = *garment.panels[p].placement;
+    // Panels hung from the shoulders or neck start a little high, so their shoulder seams close
+    // over the shoulders instead of having to climb them; gravity lowers them while draping.
+    const bool hung = rp.region == BodyRegion::torso && (h.landmark == Landmark::shoulder || h.landmark == Landmark::neck);
+    const BodyRegion lm_region = rp.trousers ? BodyRegion::torso : rp.region;
+    t_anchor[k] = station_t(landmark_point(body.landmarks, h.landmark, lm_region)) + (hung ? kShoulderLift : 0.0f);
+    clearance = std::max(clearance, static_cast<float>(h.clearance));
+    for (const Vec3f& q : mesh.panels[p].mesh.positions) {
+      vt[k].push_back(t_anchor[k] + (q.y() - static_cast<float>(h.anchor.y())));
+      t_lo = std::min(t_lo, vt[k].back());
+      t_hi = std::max(t_hi, vt[k].back());
+    }
+  }
+  clearance += extra;
+
+  // Trousers looser than the waist sit lower, where the body is as wide as their waistband (as they
+  // would slide down on a person), so they do not drop while draping.
+  if (rp.trousers) {
+    const float drop = waistband_drop(body, garment, mesh, rp.panels);
+    for (size_t k = 0; k < rp.panels.size(); ++k) {
+      t_anchor[k] -= drop;
+      for (float& t : vt[k]) t -= drop;
+    }
+    t_lo -= drop;
+    t_hi -= drop;
+  }
+
+  // Stations: the panels' nominal heights plus room below (rolling along a slope takes more height),
+  // never below 1 cm above the floor.
+  constexpr float kRoomBelow = 0.25f, kRoomAbove = 0.05f, kAboveFloor = 0.01f;
+  float t_min = t_lo - kRoomBelow;
+  if (axis.up.y() > 0.2f) t_min = std::max(t_min, std::min(t_lo, (kAboveFloor - axis.origin.y()) / axis.up.y()));
+  const int stations = std::max(2, static_cast<int>(std::ceil((t_hi + kRoomAbove - t_min) / kStation)) + 1);
+  const auto station_of = [&](float t) {
+    return std::clamp(static_cast<int>(std::lround((t - t_min) / kStation)), 0, stations - 1);
+  };
+
+  // Trousers: the torso's surface above the crotch, the legs' below, blended over the crotch curve.
+  const float crotch = body.landmarks.crotch.y();
+  const float blend_lo = crotch - 0.03f, blend_hi = crotch + 0.08f;
+
+  // Panel arc widths per station (counted above blend_hi for the torso surface of trousers, below it
+  // for their legs), to size the sections so a surface's panels fit side by side.
+  const auto needed_for = [&](auto counts) {
+    std::vector<float> needed(static_cast<size_t>(stations), 0.0f);
+    for (size_t k = 0; k < rp.panels.size(); ++k) {
+      const PlacementHint& h = *garment.panels[rp.panels[k]].placement;
+      if (!counts(h)) continue;
+      std::vector<Vec2f> range(static_cast<size_t>(stations), Vec2f(1e9f, -1e9f));
+      const auto& q = mesh.panels[rp.panels[k]].mesh.positions;
+      for (size_t v = 0; v < q.size(); ++v) {
+        if (rp.trousers && (counts.torso ? vt[k][v] < blend_hi : vt[k][v] >= blend_hi)) continue;
+        Vec2f& r = range[static_cast<size_t>(station_of(vt[k][v]))];
+        r = Vec2f(std::min(r.x(), q[v].x()), std::max(r.y(), q[v].y()));
+      }
+      for (int s = 0; s < stations; ++s) {
+        const Vec2f r = range[static_cast<size_t>(s)];
+        if (r.y() >= r.x()) needed[static_cast<size_t>(s)] += (r.y() - r.x()) + 2 * kPanelGap;
+      }
+    }
+    return needed;
+  };
+  struct Counts {
+    bool torso;
+    BodyRegion leg;
+    bool operator()(const PlacementHint& h) const { return torso || h.body_part == leg; }
+  };
+
+  const float no_cut = -std::numeric_limits<float>::max();
+  Stack surface = build_stack(
+      body, [&](BodyPart part) { return in_region(part, rp.trousers ? BodyRegion::torso : rp.region); }, axis, t_min,
+      stations, clearance, needed_for(Counts{true, rp.region}), !rp.trousers && is_limb(rp.region),
+      rp.region == BodyRegion::left_leg || rp.region == BodyRegion::right_leg ? (rp.trousers ? no_cut : 0.0f) : no_cut);
+  // Heights along the surface for trousers and for garments without sleeves. With sleeves, flat y
+  // stays height: a sleeve's cap is placed on its arm's cylinder by height, and the torso's
+  // armholes must stay level with it.
+  bool sleeves = false;
+  for (const Panel& panel : garment.panels)
+    sleeves = sleeves || (panel.placement && (panel.placement->body_part == BodyRegion::left_arm ||
+                                              panel.placement->body_part == BodyRegion::right_arm));
+  const bool along_surface = rp.trousers || !sleeves;
+
+  // Panels hung from the shoulders (without sleeves): the surface closes over the shoulders like a
+  // roof, front and back meeting over the body (no closer than 1 cm to it), so shoulder seams
+  // start nearly closed.
+  float t_hung = -std::numeric_limits<float>::max();
+  for (size_t k = 0; k < rp.panels.size(); ++k) {
+    const PlacementHint& h = *garment.panels[rp.panels[k]].placement;
+    if (rp.region == BodyRegion::torso && (h.landmark == Landmark::shoulder || h.landmark == Landmark::neck))
+      t_hung = std::max(t_hung, t_anchor[k]);
+  }
+  if (along_surface && t_hung > t_min) {
+    constexpr float kRoof = 0.08f, kOverBody = 0.01f;
+    for (int s = 0; s < surface.stations(); ++s) {
+      const float f = (surface.t_of(s) - (t_hung - kRoof)) / kRoof;
+      if (f <= 0) continue;
+      Section& c = surface.sec[static_cast<size_t>(s)];
+      c.b = std::max(c.body_b + kOverBody, c.b * std::sqrt(std::max(0.0f, 1 - f * f)));
+      build_arc(c);
+    }
+  }
+  std::array<Stack, 2> legs;  // trousers: left, right
+  if (rp.trousers)
+    for (int side = 0; side < 2; ++side) {
+      const BodyRegion leg = side == 0 ? BodyRegion::left_leg : BodyRegion::right_leg;
+      const float ankle = (side == 0 ? body.landmarks.left_ankle : body.landmarks.right_ankle).y();
+      legs[static_cast<size_t>(side)] = build_stack(body, [&](BodyPart part) { return in_region(part, leg); }, axis, t_min,
+                                                    stations, clearance, needed_for(Counts{false, leg}), false, ankle);
+    }
 
   // A limb wrapped by one panel (a one-piece sleeve or trouser leg sewn to itself) is centred on
   // the limb's top (arms) or outside (legs), whatever its side says; otherwise the side decides.
   float single_panel_angle = -1;
-  if (is_limb(rp.region) && rp.panels.size() == 1) {
+  if (!rp.trousers && is_limb(rp.region) && rp.panels.size() == 1) {
     const bool arm = rp.region == BodyRegion::left_arm || rp.region == BodyRegion::right_arm;
     const Vec3f outside = arm ? Vec3f::UnitY()
                               : (rp.region == BodyRegion::left_leg ? Vec3f::UnitX() : Vec3f(-Vec3f::UnitX()));
     const Vec3f dir = outside - outside.dot(axis.up) * axis.up;
-    single_panel_angle = std::atan2(dir.dot(side_dir), dir.dot(axis.front));
+    single_panel_angle = std::atan2(dir.dot(surface.side_dir), dir.dot(axis.front));
     if (single_panel_angle < 0) single_panel_angle += 2 * kPi;
   }
 
-  // A running mean over the same window turns the running maximum's steps into gentle slopes, so
-  // the rolled panel is hardly stretched along the axis.
-  {
-    std::vector<Section> smooth = sec;
-    for (int s = 0; s < stations; ++s) {
-      float a = 0, b = 0;
-      Vec3f c = Vec3f::Zero();
-      int n = 0;
-      for (int j = std::max(0, s - kSmooth); j <= std::min(stations - 1, s + kSmooth); ++j, ++n) {
-        a += sec[static_cast<size_t>(j)].a;
-        b += sec[static_cast<size_t>(j)].b;
-        c += sec[static_cast<size_t>(j)].centre - kStation * static_cast<float>(j - s) * axis.up;
-      }
-      Section& t = smooth[static_cast<size_t>(s)];
-      t.a = a / static_cast<float>(n);  // >= the body's extent here: a mean of running maxima
-      t.b = b / static_cast<float>(n);
-      t.centre = c / static_cast<float>(n);
-      build_arc(t);
-    }
-    sec = std::move(smooth);
-  }
-
-  // Roll every panel: x -> arc from its side's centre line, y -> station.
+  // Roll every panel.
   for (size_t k = 0; k < rp.panels.size(); ++k) {
     const size_t p = rp.panels[k];
     const PlacementHint& h = *garment.panels[p].placement;
-    const float phi_c = single_panel_angle >= 0 ? single_panel_angle : side_angle(h.side);
     const auto& q = mesh.panels[p].mesh.positions;
-    std::vector<Vec3f>& x = out.positions[p];
-    x.resize(q.size());
-    for (size_t v = 0; v < q.size(); ++v) {
-      const float t = vt[k][v];
-      const Section& c = sec[static_cast<size_t>(station_of(t))];
-      const float s0 = c.arc[static_cast<size_t>(std::lround(phi_c / (2 * kPi) * kAngles)) % kAngles];
-      const float phi = angle_at(c, s0 + q[v].x() - static_cast<float>(h.anchor.x()));
-      const Vec3f centre = c.centre + (t - (c.centre - axis.origin).dot(axis.up)) * axis.up;
-      x[v] = centre + c.a * std::sin(phi) * side_dir + c.b * std::cos(phi) * axis.front;
+    PanelMap m;
+    m.surface = &surface;
+    m.phi_c = single_panel_angle >= 0 ? single_panel_angle : side_angle(h.side);
+    m.x0 = static_cast<float>(h.anchor.x());
+    m.t_anchor = t_anchor[k];
+    m.y_anchor = static_cast<float>(h.anchor.y());
+    if (rp.trousers) {
+      // On the leg the panel is centred on its side by the middle of its lowest 2 cm (the hem).
+      m.leg = &legs[h.body_part == BodyRegion::left_leg ? 0 : 1];
+      m.leg_phi_c = side_angle(h.side);
+      float y_low = std::numeric_limits<float>::max();
+      for (const Vec3f& v : q) y_low = std::min(y_low, v.y());
+      float lo = std::numeric_limits<float>::max(), hi = -lo;
+      for (const Vec3f& v : q)
+        if (v.y() < y_low + 0.02f) {
+          lo = std::min(lo, v.x());
+          hi = std::max(hi, v.x());
+        }
+      m.leg_x0 = 0.5f * (lo + hi);
+      m.blend_lo = blend_lo;
+      m.blend_hi = blend_hi;
     }
+    roll_panel(m, q, along_surface, out.positions[p]);
     PanelPlacement& info = out.info[p];
     info.panel = garment.panels[p].name;
-    info.region = to_string(rp.region);
+    info.region = rp.trousers ? "hips and " + std::string(to_string(h.body_part)) : std::string(to_string(rp.region));
     info.clearance = clearance;
   }
 }
@@ -329,9 +617,12 @@ PlacedPanels place_panels(const Body& body, const Garment& garment, const Garmen
   for (size_t p = 0; p < garment.panels.size(); ++p) {
     if (!garment.panels[p].placement)
       throw InputError(garment.source, "panel '" + garment.panels[p].name + "' has no placement (body_part, side, landmark)");
-    const BodyRegion r = garment.panels[p].placement->body_part;
-    auto it = std::find_if(regions.begin(), regions.end(), [&](const RegionPanels& x) { return x.region == r; });
-    if (it == regions.end()) regions.push_back({r, {p}});
+    const PlacementHint& h = *garment.panels[p].placement;
+    const bool trousers = spans_hips(h);
+    const BodyRegion r = trousers ? BodyRegion::torso : h.body_part;
+    auto it = std::find_if(regions.begin(), regions.end(),
+                           [&](const RegionPanels& x) { return x.region == r && x.trousers == trousers; });
+    if (it == regions.end()) regions.push_back({r, trousers, {p}});
     else it->panels.push_back(p);
   }
 
@@ -348,7 +639,8 @@ PlacedPanels place_panels(const Body& body, const Garment& garment, const Garmen
         contact.resize(x.size());
         body_collider.query(x, 0.05f, contact);
         size_t n = 0;
-        for (const ContactSample& c : contact) n += c.distance < 2 * collision_thickness ? 1 : 0;
+        for (size_t v = 0; v < x.size(); ++v)
+          if (contact[v].distance < 2 * collision_thickness && !near_other_part(body, x[v], rp)) ++n;
         out.info[p].vertices_touching = n;
         touching += n;
       }

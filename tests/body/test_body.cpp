@@ -126,11 +126,17 @@ TEST(BodyFromMeasurements, SizesXsToXxlMeasureBackWithinOneCentimetre) {
     if (sanitized() && size.name != std::string("female XS") && size.name != std::string("male XXL")) continue;
     const MeasurementRequest request{{"height", size.height}, {"bust", size.bust}, {"waist", size.waist}, {"hips", size.hips}};
     const Body body = make_body(size.sex, request, options);
+    std::string line;
     for (const auto& [key, value] : request) {
       const auto& table = measurement_table();
       const auto row = std::find_if(table.begin(), table.end(), [&](const MeasurementInfo& r) { return r.key == key; });
-      EXPECT_NEAR(body.measurements.*(row->field), value, 0.01f) << size.name << " " << key;
+      const float measured = body.measurements.*(row->field);
+      EXPECT_NEAR(measured, value, 0.01f) << size.name << " " << key;
+      char item[80];
+      std::snprintf(item, sizeof item, " %s %.1f/%.1f", key.c_str(), 100 * value, 100 * measured);
+      line += item;
     }
+    std::printf("%-10s requested/measured cm:%s\n", size.name, line.c_str());
     expect_valid_body(body, size.name);
   }
 }
@@ -155,8 +161,14 @@ TEST(BodyFromMeasurements, AllKeysAtOnce) {
     const MeasurementRequest request = parse_measurements(text);
     ASSERT_EQ(request.size(), measurement_table().size());
     const Body body = make_body(sex, request, options);
-    for (const auto& row : measurement_table())
-      EXPECT_NEAR(body.measurements.*row.field, request.at(std::string(row.key)), 0.01f) << row.key << " of " << text;
+    float worst = 0;
+    for (const auto& row : measurement_table()) {
+      const float error = body.measurements.*row.field - request.at(std::string(row.key));
+      EXPECT_NEAR(error, 0.0f, 0.01f) << row.key << " of " << text;
+      worst = std::max(worst, std::abs(error));
+    }
+    std::printf("all keys, %s %.2f m: worst key off by %.1f mm\n", sex == Sex::Female ? "female" : "male",
+                request.at("height"), 1000 * worst);
   }
 }
 
@@ -198,9 +210,13 @@ TEST(BodyFromFiles, GarmentCodeMeanBodyMatchesPublishedMeasurements) {
       {"waist", m.waist, 0.02},         {"hips", m.hips, 0.02},           {"leg_circ", m.thigh, 0.02},
       {"wrist", m.wrist, 0.02},         {"arm_length", m.arm_length, 0.02}, {"shoulder_w", m.shoulder_width, 0.02},
       {"waist_line", m.back_length, 0.02}};
+  // Printed so that the figures in docs/bodies.md can be re-run:
+  //   build/tests/test_body --gtest_filter='*GarmentCodeMean*'
   for (const auto& [key, ours, tolerance] : checks) {
     ASSERT_TRUE(yaml.count(key)) << key;
     EXPECT_NEAR(ours, yaml.at(key) / 100.0, tolerance) << key << ": ours " << ours * 100 << " cm, yaml " << yaml.at(key);
+    std::printf("mean_all %-10s ours %6.1f cm, mean_all.yaml %6.1f cm, difference %+5.1f cm\n", key, 100.0 * ours,
+                yaml.at(key), 100.0 * ours - yaml.at(key));
   }
 }
 

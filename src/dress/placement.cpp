@@ -117,7 +117,7 @@ bool in_region(BodyPart part, BodyRegion r) {
 struct Section {
   Vec3f centre = Vec3f::Zero();
   float a = 0.1f, b = 0.1f;
-  float body_b = 0.0f;  // the body's half depth here (no clearance)
+  float body_b = 0.0f;  // the body's half depth here (no clearance), away from the midline (neck)
   std::vector<float> arc;  // arc length at angle index k of kAngles (phi from front towards side)
   float perimeter() const { return arc.back(); }
 };
@@ -207,14 +207,18 @@ Stack build_stack(const Body& body, InSurface in, const Axis& axis, float t_min,
   st.sec.resize(static_cast<size_t>(stations));
   const size_t n = static_cast<size_t>(stations);
 
-  // Body extent per station, in the axis frame (across = side_dir, depth = front).
-  std::vector<Bounds> extent(n);
+  // Body extent per station, in the axis frame (across = side_dir, depth = front); `beside` leaves
+  // out a band of 14 cm around the midline (the neck), for the roof over the shoulders.
+  constexpr float kNeckHalfWidth = 0.07f;
+  std::vector<Bounds> extent(n), beside(n);
   for (size_t i = 0; i < body.mesh.positions.size(); ++i) {
     if (!in(body.parts[i])) continue;
     const Vec3f d = body.mesh.positions[i] - axis.origin;
     const float t = d.dot(axis.up);
     if (t < t_cut || t < t_min - kStation || t > st.t_max() + kStation) continue;
-    extent[static_cast<size_t>(st.station_of(t))].extend(Vec3f(d.dot(st.side_dir), d.dot(axis.front), 0.0f));
+    const Vec3f e(d.dot(st.side_dir), d.dot(axis.front), 0.0f);
+    extent[static_cast<size_t>(st.station_of(t))].extend(e);
+    if (std::abs(e.x()) > kNeckHalfWidth) beside[static_cast<size_t>(st.station_of(t))].extend(e);
   }
   // Stations without body (above a limb's end, below the body) copy their nearest neighbour.
   for (int pass = 0; pass < 2; ++pass)
@@ -239,7 +243,12 @@ Stack build_stack(const Body& body, InSurface in, const Axis& axis, float t_min,
     const Vec3f ctr = e.empty() ? Vec3f::Zero() : e.center();
     const Vec3f half = e.empty() ? Vec3f(0.1f, 0.1f, 0) : Vec3f(0.5f * e.size());
     c.centre = axis.origin + st.t_of(s) * axis.up + ctr.x() * st.side_dir + ctr.y() * axis.front;
-    c.body_b = half.y();
+    c.body_b = 0;
+    for (int j = std::max(0, s - kSmooth); j <= std::min(stations - 1, s + kSmooth); ++j)
+      if (!beside[static_cast<size_t>(j)].empty()) {
+        const Bounds& b = beside[static_cast<size_t>(j)];
+        c.body_b = std::max({c.body_b, b.max.y() - ctr.y(), ctr.y() - b.min.y()});
+      }
     if (circles) {
       c.a = c.b = std::max(half.x(), half.y()) + clearance;
     } else {

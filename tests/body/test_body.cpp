@@ -330,7 +330,25 @@ TEST(BodyFromFiles, WhatIsNotABodyIsRefusedWithExitTwo) {
     std::ofstream out(dir / "tiny.obj");
     out << "v 0 0 0\nv 0.05 0 0\nv 0 0.1 0\nv 0 0 0.05\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
   }
-  for (const char* name : {"cube.obj", "tiny.obj"}) {
+  // A 1.7 m cylinder: the right height, but no legs. And a file that is not a mesh at all.
+  {
+    std::ofstream out(dir / "pillar.obj");
+    constexpr int n = 24;
+    for (float y : {0.0f, 1.7f})
+      for (int i = 0; i < n; ++i) {
+        const float a = 2.0f * 3.14159265f * static_cast<float>(i) / n;
+        out << "v " << 0.15f * std::cos(a) << ' ' << y << ' ' << 0.15f * std::sin(a) << '\n';
+      }
+    for (int i = 0; i < n; ++i) {
+      const int j = (i + 1) % n;
+      out << "f " << i + 1 << ' ' << j + 1 << ' ' << n + j + 1 << "\nf " << i + 1 << ' ' << n + j + 1 << ' ' << n + i + 1 << '\n';
+    }
+  }
+  {
+    std::ofstream out(dir / "letter.obj");
+    out << "Dear customer,\nthis is not a mesh.\n";
+  }
+  for (const char* name : {"cube.obj", "tiny.obj", "pillar.obj", "letter.obj"}) {
     const auto r = drape::test::run_drape("measure " + (dir / name).string());
     EXPECT_EQ(r.exit_code, 2) << name << ": " << r.err;
     EXPECT_NE(r.err.find(name), std::string::npos) << r.err;

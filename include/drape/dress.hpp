@@ -41,11 +41,11 @@ struct DressOptions {
   // `drape_damping` (1/s; quasi-static draping: it changes how fast the rest shape is reached, not
   // the rest shape).
   double max_drape_seconds = 2.0;
-  float drape_damping = 4.0f;
-  // Settled: the garment's mass-weighted RMS speed sqrt(2 E_kin / M) below `settle_speed` for
-  // `settle_window_s` consecutive seconds of simulated time.
-  float settle_speed = 0.01f;      // m/s
-  double settle_window_s = 0.1;    // s
+  float drape_damping = 10.0f;
+  // Settled: no vertex's net displacement over a window of `settle_window_s` of simulated time
+  // exceeds `settle_distance_m` (an average speed below 1 cm/s for every vertex).
+  float settle_distance_m = 0.001f;  // m
+  double settle_window_s = 0.1;      // s
   // Strain limiting per step: velocity-modification passes (sec. 3.3), then Provot
   // position-modification passes that pull back what seam holds and contacts stretched.
   int strain_passes = 4;

@@ -3,6 +3,8 @@
 // atomically; the directory gets all three or, on an error before writing, none.
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "drape/dress.hpp"
@@ -79,6 +81,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"drape_wall_seconds", g.drape_seconds},
                         {"simulated_seconds", g.state.time},
                         {"final_max_speed_m_per_s", g.state.max_speed},
+                        {"final_rms_speed_m_per_s", std::sqrt(2.0 * g.state.kinetic_energy / g.model.total_mass())},
                         {"time_step_s", g.time_step},
                         {"centre_drop_m", g.drop_m},
                         {"strain_threshold", g.model.fabric.strain_threshold},
@@ -93,7 +96,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                        {"mesher", o.mesh.mesher == Mesher::grid ? "grid" : "triangle"},
                        {"edge_length_m", o.mesh.edge_length},
                        {"seam_closed_m", o.seam_closed_m},
-                       {"settle_speed_m_per_s", o.settle_speed},
+                       {"settle_distance_m", o.settle_distance_m},
                        {"settle_window_s", o.settle_window_s},
                        {"max_iterations", o.max_iterations},
                        {"penetration_tolerance_m", kPenetrationTolerance}};

@@ -11,8 +11,10 @@
 // particles stay distinct, so the seam gap in the report is the real distance between them.
 // Sewing ends when every pair is joined.
 // Draping: gravity on, the fabric's friction, viscous damping raised for quasi-static draping.
-// Settled: the mass-weighted RMS speed stays below settle_speed for settle_window_s of simulated
-// time (a few corner vertices may still tremble; the garment as a whole is at rest).
+// Settled: over a window of settle_window_s of simulated time no vertex moved more than
+// settle_distance_m (its net displacement: the shape has stopped changing; a vertex pinched between
+// arm and torso may still tremble by a fraction of a millimetre from step to step, which this
+// ignores and a speed threshold would not).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -118,9 +120,10 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   settings.friction = -1.0f;
   settings.air_damping = o.drape_damping;
   const Vec3f before = centre_of_mass(g.model, g.state.x);
-  const double total_mass = g.model.total_mass();
   const double drape_start = g.state.time;
-  double calm_since = -1;
+  // Settle windows: positions at the start of the current window (allocated once).
+  std::vector<Vec3f> window_start = g.state.x;
+  double window_began = g.state.time;
   g.settled = false;
   while (g.status == StepStatus::Ok && g.state.time - drape_start < o.max_drape_seconds && g.state.iterations < cap) {
     g.status = step(g.model, g.state, colliders, settings, scratch, &g.profile);
@@ -128,15 +131,15 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     limit_seams(g.model, g.state, g.seam_pairs, dt);
     join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
     settings.joined_pairs = held;
-    const double rms_speed = std::sqrt(2.0 * g.state.kinetic_energy / total_mass);
-    if (rms_speed < o.settle_speed) {
-      if (calm_since < 0) calm_since = g.state.time;
-      if (g.state.time - calm_since >= o.settle_window_s) {
+    if (g.state.time - window_began >= o.settle_window_s) {
+      float moved2 = 0;
+      for (size_t i = 0; i < window_start.size(); ++i) moved2 = std::max(moved2, (g.state.x[i] - window_start[i]).squaredNorm());
+      if (std::sqrt(moved2) < o.settle_distance_m) {
         g.settled = true;
         break;
       }
-    } else {
-      calm_since = -1;
+      window_start = g.state.x;  // same size: no allocation
+      window_began = g.state.time;
     }
     report("draping", o.max_drape_seconds);
   }

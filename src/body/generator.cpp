@@ -145,7 +145,10 @@ Model build_model(const Shape& s) {
                                    female ? 0.74f : 0.70f, 0.004f, kTorsoExponent);
   // The waist sits forward of the hips and chest (the lumbar curve): the small of the back is
   // hollow and the front under the rib cage comes forward again below the bust.
-  const Ring waist = ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.68f, 0.68f, 0.016f * H / 1.65f, kTorsoExponent);
+  // A waist nearly as full as the rib cage is a belly, not a hollow back: it stays over the hips.
+  const float lordosis = std::clamp((s.underbust_girth - s.waist_girth) / 0.04f, 0.0f, 1.0f);
+  const Ring waist =
+      ring_with_girth(waist_y, s.waist_girth, 1.0f, 0.68f, 0.68f, lordosis * 0.016f * H / 1.65f, kTorsoExponent);
   const Ring underbust = ring_with_girth(underbust_y, s.underbust_girth, 1.0f, 0.72f, 0.72f, 0.004f, kTorsoExponent);
   const float rib_girth = female ? 1.03f * s.underbust_girth : 0.98f * s.chest_girth;
   const Ring chest = ring_with_girth(bust_y, rib_girth, 1.0f, female ? 0.70f : 0.76f, 0.72f, -0.01f, kTorsoExponent);

@@ -310,12 +310,15 @@ Landmarks find_landmarks(const Mesh& mesh, const std::string& source) {
   const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
 
   // Underbust: going down from the bust, the first dip of the front profile (the fold under the
-  // breasts, or where the front stops receding), then 1 cm lower to clear the breast tissue.
+  // breasts, or where the front stops receding), then 1 cm lower to clear the breast tissue. A flat
+  // chest (the front recedes by less than 5 mm before the dip) has no fold to find: its underbust
+  // is 4 % of the height under the bust points, where the pectorals end.
   {
-    float min_front = 1e9f, min_y = -1.0f;
+    float min_front = 1e9f, min_y = -1.0f, top_front = -1e9f;
     for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f) {
       auto s = torso_section(mesh, y);
       if (!s) continue;
+      top_front = std::max(top_front, s->max.y());
       if (s->max.y() < min_front) {
         min_front = s->max.y();
         min_y = y;
@@ -324,6 +327,10 @@ Landmarks find_landmarks(const Mesh& mesh, const std::string& source) {
       }
     }
     if (min_y < 0) fail(source, "no torso below the bust");
+    if (top_front - min_front < 0.005f) {
+      min_y = bust_y - 0.04f * height + 0.01f;
+      if (auto s = torso_section(mesh, min_y - 0.01f)) min_front = s->max.y();
+    }
     lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
   }
 

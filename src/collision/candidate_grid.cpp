@@ -64,6 +64,10 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band)
       std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end(), [](const Candidate& a, const Candidate& b) {
         return a.centre_distance < b.centre_distance || (a.centre_distance == b.centre_distance && a.triangle < b.triangle);
       });
+      if (out.size() - first > kMaxList) {
+        out[first + kMaxList].triangle = kTruncated;  // keeps the first left out's distance
+        out.resize(first + kMaxList + 1);
+      }
       count[c] = static_cast<uint32_t>(out.size() - first);
     }
   }
@@ -92,6 +96,7 @@ CandidateGrid::Answer CandidateGrid::closest(const Vec3f& p, float radius, Surfa
   for (uint32_t k = begin; k < end; ++k) {
     const Candidate& candidate = candidates_[k];
     if (candidate.centre_distance - offset >= best) break;  // d(p, T) >= d(c, T) - |p - c|: no nearer one follows
+    if (candidate.triangle == kTruncated) return found ? Answer::kTruncatedFound : Answer::kTruncatedNone;
     const SurfaceHit h = surface_.closest_on(candidate.triangle, p);
     if (h.distance < best) {
       best = h.distance;
@@ -104,7 +109,7 @@ CandidateGrid::Answer CandidateGrid::closest(const Vec3f& p, float radius, Surfa
 
 double CandidateGrid::mean_list_length() const {
   size_t lists = 0;
-  for (size_t c = 0; c + 1 < first_.size(); ++c) lists += first_[c + 1] > first_[c];
+  for (size_t c = 0; c + 1 < first_.size(); ++c) lists += first_[c + 1] > first_[c];  // truncation entries included
   return lists ? static_cast<double>(candidates_.size()) / static_cast<double>(lists) : 0.0;
 }
 

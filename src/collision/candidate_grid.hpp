@@ -29,9 +29,11 @@ class CandidateGrid {
   // Built over the surface's current pose, with the BVH (same pose) answering the build's searches.
   CandidateGrid(const TriangleBvh& bvh, float cell, float band);
 
-  enum class Answer : uint8_t { kFound, kNone, kUnknown };
+  enum class Answer : uint8_t { kFound, kNone, kUnknown, kTruncatedFound, kTruncatedNone };
   // kFound: hit is the exact nearest point, within radius. kNone: nothing lies within radius.
   // kUnknown: p lies outside the listed cells and the radius reaches beyond them: ask the tree.
+  // kTruncated*: the scan reached the end of a shortened list (see kMaxList) before it could stop:
+  // hit is the best so far (kTruncatedFound) or there is none; the tree must look for a nearer one.
   Answer closest(const Vec3f& p, float radius, SurfaceHit& hit) const;
 
   float band() const { return band_; }
@@ -42,9 +44,13 @@ class CandidateGrid {
 
  private:
   struct Candidate {
-    uint32_t triangle;
-    float centre_distance;  // d(cell centre, triangle)
+    uint32_t triangle;      // kTruncated: the list goes on beyond this entry
+    float centre_distance;  // d(cell centre, triangle); of the first left out for kTruncated
   };
+  // Lists are cut after this many triangles (a scan stops after about 7 on a body), ending in a
+  // kTruncated entry: it keeps the grid small enough to stay in cache.
+  static constexpr uint32_t kMaxList = 16;
+  static constexpr uint32_t kTruncated = ~uint32_t{0};
 
   const BodySurface& surface_;
   float cell_, band_, half_diagonal_;

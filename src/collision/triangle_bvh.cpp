@@ -95,8 +95,14 @@ void TriangleBvh::build_candidate_grid(float cell, float band) {
 
 bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
   if (grid_) {
-    const CandidateGrid::Answer answer = grid_->closest(p, radius, hit);
-    if (answer != CandidateGrid::Answer::kUnknown) return answer == CandidateGrid::Answer::kFound;
+    using Answer = CandidateGrid::Answer;
+    const Answer answer = grid_->closest(p, radius, hit);
+    if (answer == Answer::kFound || answer == Answer::kNone) return answer == Answer::kFound;
+    if (answer == Answer::kTruncatedFound) {  // the tree looks only for something nearer than the best so far
+      SurfaceHit nearer;
+      if (closest_in_tree(p, hit.distance, nearer)) hit = nearer;
+      return true;
+    }
   }
   return closest_in_tree(p, radius, hit);
 }

@@ -1,0 +1,50 @@
+// The candidate grid (collision/candidate_grid.hpp) must give exactly the tree's answer: the same
+// nearest distance for every point, inside or outside the band, for any query radius.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <random>
+
+#include "collision/triangle_bvh.hpp"
+#include "drape/io.hpp"
+#include "support/test_support.hpp"
+
+namespace drape::collision {
+namespace {
+
+TEST(CandidateGrid, AnswersExactlyAsTheTree) {
+  const auto path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
+  const Mesh body = read_mesh(path);
+  const BodySurface surface(body.positions, body.triangles);
+  TriangleBvh bvh(surface, /*refit=*/true);
+  bvh.build_candidate_grid();
+  ASSERT_NE(bvh.candidate_grid(), nullptr);
+  // Points up to 4 cm off the skin either way (beyond the 12 mm band too), near random vertices.
+  const auto normals = vertex_normals(body.positions, body.triangles);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<size_t> vertex(0, body.positions.size() - 1);
+  std::uniform_real_distribution<float> offset(-0.04f, 0.04f), jitter(-0.005f, 0.005f);
+  const int count = std::getenv("DRAPE_SANITIZED") ? 2000 : 20000;
+  int found = 0;
+  for (int i = 0; i < count; ++i) {
+    const size_t v = vertex(rng);
+    const Vec3f p = body.positions[v] + offset(rng) * normals[v] + Vec3f(jitter(rng), jitter(rng), jitter(rng));
+    for (float radius : {0.005f, 0.02f, 0.1f}) {
+      SurfaceHit grid_hit, tree_hit;
+      const bool in_grid = bvh.closest(p, radius, grid_hit);
+      const bool in_tree = bvh.closest_in_tree(p, radius, tree_hit);
+      ASSERT_EQ(in_grid, in_tree) << "point " << p.transpose() << " radius " << radius;
+      if (in_grid) {
+        ASSERT_NEAR(grid_hit.distance, tree_hit.distance, 1e-6f) << "point " << p.transpose();
+        ++found;
+      }
+    }
+  }
+  EXPECT_GT(found, count);  // most points have the body within the larger radii
+  // A moving body's update drops the grid (its lists hold for the old pose only).
+  bvh.update();
+  EXPECT_EQ(bvh.candidate_grid(), nullptr);
+}
+
+}  // namespace
+}  // namespace drape::collision

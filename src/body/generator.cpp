@@ -328,9 +328,9 @@ void correct(Shape& s, const MeasurementRequest& full, const MeasurementRequest&
   s.crotch_y += shift("inseam", m.inseam);
   s.arm_scale *= ratio("arm_length", m.arm_length);
   // Both shoulders move. Narrower than the chest allows would push the arms into the torso: the
-  // shoulders come in by at most a quarter of the deltoid's radius.
+  // shoulders come in by at most half the deltoid's radius.
   s.shoulder_offset = std::max(s.shoulder_offset + shift("shoulder_width", m.shoulder_width),
-                               -0.25f * 1.2f * s.upper_arm_girth / (2 * kPi));
+                               -0.5f * 1.2f * s.upper_arm_girth / (2 * kPi));
   s.waist_y -= 0.7f * shift("back_length", m.back_length);
 }
 

@@ -161,6 +161,24 @@ BENCHMARK_CAPTURE(BM_Update, image, CollisionMethod::image)->Unit(benchmark::kMi
 BENCHMARK_CAPTURE(BM_Update, bvh, CollisionMethod::bvh)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Update, sdf, CollisionMethod::sdf)->Unit(benchmark::kMillisecond)->Iterations(2);
 
+// Per frame when only part of the body moves (the left arm, x > 0.25 m, rises 1 mm per frame): the
+// distance field re-samples only the bricks near it.
+void BM_UpdateArm(benchmark::State& state, CollisionMethod method) {
+  if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
+  const auto collider = make_body_collider(*body(), method);
+  std::vector<Vec3f> moved = body()->positions;
+  double t = 0;
+  for (auto _ : state) {
+    t += 1.0 / 30.0;
+    for (Vec3f& p : moved)
+      if (p.x() > 0.25f) p.y() += 0.001f;
+    collider->set_surface(moved, t);
+  }
+  state.counters["build_ms"] = collider->build_stats().build_seconds * 1e3;
+  state.counters["rebuilt_fraction"] = collider->build_stats().rebuilt_fraction;
+}
+BENCHMARK_CAPTURE(BM_UpdateArm, sdf, CollisionMethod::sdf)->Unit(benchmark::kMillisecond)->Iterations(3);
+
 void BM_InsideTest(benchmark::State& state) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
   const InsideTest test(*body());

@@ -51,6 +51,7 @@ struct BodyColliderBuildStats {
   double build_seconds = 0;  // last set_surface (maps / BVH refit / field update)
   size_t memory_bytes = 0;   // size of the collision structure
   double hidden_fraction = 0;  // image: fraction of covered pixels answered by the BVH
+  double rebuilt_fraction = 1;  // sdf: fraction of the stored bricks re-sampled by the last update
 };
 
 // A collider for a (possibly moving or deforming) body mesh of fixed topology.

@@ -21,7 +21,91 @@ SdfCollider::SdfCollider(const Mesh& body, float voxel_size, float band)
 void SdfCollider::set_surface(std::span<const Vec3f> positions, double t) {
   surface_.set_positions(positions, t);
   bvh_->update();
-  build_field();
+  update_field();
+}
+
+// Incremental update for a moving body: only bricks near vertices that moved more than an eighth of
+// a voxel since they were last sampled are sampled again. A kept brick's samples are then off by at
+// most a quarter voxel (a distance changes no more than the surface near it moves, and a vertex's
+// drift from the pose its bricks were sampled at stays below two eighths). The region a moved vertex
+// can affect: a stored sample lies within band + brick diagonal + a triangle's size of the skin, and
+// its old or new nearest triangle within a triangle's size of the vertex, so bricks within that
+// much of the vertex's old or new position. Falls back to a full rebuild when most of the body moved or when
+// the moved surface needs a brick that stores no samples yet.
+void SdfCollider::update_field() {
+  const auto start = std::chrono::steady_clock::now();
+  const auto positions = surface_.positions();
+  const float tolerance = 0.125f * voxel_;
+  std::vector<uint32_t> moved;
+  for (uint32_t v = 0; v < positions.size(); ++v)
+    if ((positions[v] - sampled_positions_[v]).squaredNorm() > tolerance * tolerance) moved.push_back(v);
+  stats_.rebuilt_fraction = 0;
+  if (moved.empty()) {
+    stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return;
+  }
+  if (2 * moved.size() > positions.size()) return build_field();
+
+  const float brick_size = voxel_ * kBrick;
+  const float reach = band_ + std::sqrt(3.0f) * brick_size + 2 * longest_edge_ + tolerance;
+  const size_t nx = static_cast<size_t>(dims_[0]), ny = static_cast<size_t>(dims_[1]);
+  std::vector<uint8_t> dirty(brick_of_.size(), 0);
+  const auto mark = [&](const Vec3f& p, float grow) {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::floor((p[a] - grow - origin_[a]) / brick_size)));
+      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((p[a] + grow - origin_[a]) / brick_size)));
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          dirty[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] = 1;
+  };
+  for (uint32_t v : moved) {
+    // The moved surface must stay inside the grid and its band inside stored bricks.
+    for (int a = 0; a < 3; ++a)
+      if (positions[v][a] - band_ < origin_[a] || positions[v][a] + band_ > origin_[a] + static_cast<float>(dims_[a]) * brick_size)
+        return build_field();
+    mark(sampled_positions_[v], reach);
+    mark(positions[v], reach);
+  }
+  // A moved triangle's box grown by the band must lie in stored bricks, as the full build makes it
+  // (stored bricks the surface has left keep their samples: still exact, only unneeded).
+  std::vector<uint8_t> vertex_moved(positions.size(), 0);
+  for (uint32_t v : moved) vertex_moved[v] = 1;
+  for (const Tri& tri : surface_.triangles()) {
+    if (!vertex_moved[tri[0]] && !vertex_moved[tri[1]] && !vertex_moved[tri[2]]) continue;
+    Bounds tb;
+    for (uint32_t v : tri) tb.extend(positions[v]);
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(0, static_cast<int>(std::floor((tb.min[a] - band_ - origin_[a]) / brick_size)));
+      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((tb.max[a] + band_ - origin_[a]) / brick_size)));
+    }
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x)
+          if (brick_of_[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] < 0)
+            brick_of_[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] = kNewlyStored;
+  }
+  // Bricks the moved surface now needs get sample blocks (in cell order) and are sampled below.
+  for (size_t c = 0; c < brick_of_.size(); ++c)
+    if (brick_of_[c] == kNewlyStored) {
+      brick_of_[c] = static_cast<int32_t>(stored_bricks_++);
+      dirty[c] = 1;
+    }
+  distance_.resize(stored_bricks_ * kSamples);
+  nearest_triangle_.resize(stored_bricks_ * kSamples);
+  std::vector<size_t> stored, flagged;
+  for (size_t c = 0; c < dirty.size(); ++c)
+    if (dirty[c]) (brick_of_[c] >= 0 ? stored : flagged).push_back(c);
+  sample_bricks(stored);
+  judge_far_bricks(flagged);
+  for (uint32_t v : moved) sampled_positions_[v] = positions[v];
+  stats_.rebuilt_fraction = stored_bricks_ ? static_cast<double>(stored.size()) / static_cast<double>(stored_bricks_) : 0.0;
+  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
+                        nearest_triangle_.size() * sizeof(uint32_t);
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void SdfCollider::build_field() {
@@ -58,20 +142,41 @@ void SdfCollider::build_field() {
       stored_cells.push_back(c);
     }
 
-  // Exact signed samples of the stored bricks.
+  // Exact signed samples of the stored bricks; the others judged far inside or far outside.
   distance_.resize(stored_cells.size() * kSamples);
   nearest_triangle_.resize(stored_cells.size() * kSamples);
-  const auto stored = static_cast<int64_t>(stored_cells.size());
+  stored_bricks_ = stored_cells.size();
+  sample_bricks(stored_cells);
+  std::vector<size_t> flagged;
+  for (size_t c = 0; c < brick_cells; ++c)
+    if (brick_of_[c] < 0) flagged.push_back(c);
+  judge_far_bricks(flagged);
+  sampled_positions_.assign(surface_.positions().begin(), surface_.positions().end());
+  longest_edge_ = 0;
+  for (const Tri& tri : surface_.triangles())
+    for (int k = 0; k < 3; ++k)
+      longest_edge_ = std::max(longest_edge_, (surface_.position(tri[k]) - surface_.position(tri[(k + 1) % 3])).norm());
+  stats_.rebuilt_fraction = 1;
+  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
+                        nearest_triangle_.size() * sizeof(uint32_t);
+}
+
+// Exact signed samples of stored bricks (given by brick cell), in parallel: each brick independent.
+void SdfCollider::sample_bricks(const std::vector<size_t>& cells) {
+  const float brick_size = voxel_ * kBrick;
+  const auto count = static_cast<int64_t>(cells.size());
   const float infinity = std::numeric_limits<float>::infinity();
 #pragma omp parallel for schedule(dynamic, 4)
-  for (int64_t b = 0; b < stored; ++b) {
-    const size_t c = stored_cells[static_cast<size_t>(b)];
+  for (int64_t i = 0; i < count; ++i) {
+    const size_t c = cells[static_cast<size_t>(i)];
+    const auto b = static_cast<size_t>(brick_of_[c]);
     const int bx = static_cast<int>(c % static_cast<size_t>(dims_[0]));
     const int by = static_cast<int>((c / static_cast<size_t>(dims_[0])) % static_cast<size_t>(dims_[1]));
     const int bz = static_cast<int>(c / (static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1])));
     const Vec3f corner = origin_ + brick_size * Vec3f(static_cast<float>(bx), static_cast<float>(by), static_cast<float>(bz));
-    float* dist = &distance_[static_cast<size_t>(b) * kSamples];
-    uint32_t* tri = &nearest_triangle_[static_cast<size_t>(b) * kSamples];
+    float* dist = &distance_[b * kSamples];
+    uint32_t* tri = &nearest_triangle_[b * kSamples];
     for (int k = 0; k < kSamples; ++k) {
       const int x = k % kSide, y = (k / kSide) % kSide, z = k / (kSide * kSide);
       const Vec3f p = corner + voxel_ * Vec3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
@@ -85,13 +190,19 @@ void SdfCollider::build_field() {
       tri[k] = hit.triangle;
     }
   }
+}
 
-  // The other bricks inside the body's box: far inside or far outside, judged at the brick centre.
-  const auto cells = static_cast<int64_t>(brick_cells);
+// Bricks without samples: far inside when their centre is inside the body, else far outside.
+void SdfCollider::judge_far_bricks(const std::vector<size_t>& cells) {
+  const float brick_size = voxel_ * kBrick;
+  const float infinity = std::numeric_limits<float>::infinity();
+  Bounds box;
+  for (const Vec3f& p : surface_.positions()) box.extend(p);
+  const auto count = static_cast<int64_t>(cells.size());
 #pragma omp parallel for schedule(dynamic, 64)
-  for (int64_t c = 0; c < cells; ++c) {
-    if (brick_of_[static_cast<size_t>(c)] != kFarOutside) continue;
-    const auto uc = static_cast<size_t>(c);
+  for (int64_t i = 0; i < count; ++i) {
+    const size_t uc = cells[static_cast<size_t>(i)];
+    brick_of_[uc] = kFarOutside;
     const Vec3f centre = origin_ + brick_size * Vec3f(static_cast<float>(uc % static_cast<size_t>(dims_[0])) + 0.5f,
                                                       static_cast<float>((uc / static_cast<size_t>(dims_[0])) % static_cast<size_t>(dims_[1])) + 0.5f,
                                                       static_cast<float>(uc / (static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1]))) + 0.5f);
@@ -100,9 +211,6 @@ void SdfCollider::build_field() {
     bvh_->closest(centre, infinity, hit);
     if (surface_.sign(hit, centre) < 0) brick_of_[uc] = kFarInside;
   }
-  stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
-                        nearest_triangle_.size() * sizeof(uint32_t);
 }
 
 ContactSample SdfCollider::sample(const Vec3f& p, float radius) const {

@@ -5,7 +5,8 @@
 // inside. Samples are exact signed distances from the BVH (pseudo-normal sign, generalized winding
 // number where the mesh is open, so scans with small holes get the right sign) together with the
 // nearest triangle, which gives the surface velocity of a moving body. A query is a brick lookup,
-// a trilinear interpolation and its gradient (the normal).
+// a trilinear interpolation and its gradient (the normal). A moving body re-samples only the bricks
+// near vertices that moved more than an eighth of a voxel since (see update_field).
 // Hand-written rather than OpenVDB: OpenVDB would bring a large dependency for one level of bricks,
 // and a flat brick table answers faster than a VDB tree's three-level descent.
 #include <memory>
@@ -29,9 +30,12 @@ class SdfCollider final : public BodyCollider {
   static constexpr int kBrick = 8;                 // voxels per brick edge
   static constexpr int kSide = kBrick + 1;         // samples per brick edge
   static constexpr int kSamples = kSide * kSide * kSide;
-  static constexpr int32_t kFarOutside = -1, kFarInside = -2;
+  static constexpr int32_t kFarOutside = -1, kFarInside = -2, kNewlyStored = -3;
 
   void build_field();
+  void update_field();
+  void sample_bricks(const std::vector<size_t>& cells);
+  void judge_far_bricks(const std::vector<size_t>& cells);
   ContactSample sample(const Vec3f& p, float radius) const;
 
   BodySurface surface_;
@@ -42,6 +46,9 @@ class SdfCollider final : public BodyCollider {
   std::vector<int32_t> brick_of_;           // per brick cell: sample block index, or kFarOutside / kFarInside
   std::vector<float> distance_;             // kSamples per stored brick
   std::vector<uint32_t> nearest_triangle_;  // kSamples per stored brick
+  size_t stored_bricks_ = 0;
+  std::vector<Vec3f> sampled_positions_;    // vertex positions the samples near each vertex were taken at
+  float longest_edge_ = 0;
   BodyColliderBuildStats stats_;
 };
 

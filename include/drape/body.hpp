@@ -123,6 +123,8 @@ MeasurementRequest parse_measurements(std::string_view text);
 // Builds a smooth, watertight, rigged body (A-pose, arms ~45 degrees down) whose measurements,
 // taken back off the mesh by measure_body, match the request within 1 cm. InputError("--measurements")
 // when the request is not self-consistent enough to build (e.g. waist larger than twice the hips).
+// A combination the shape cannot reach (shoulders much narrower than a large chest) is built as
+// close as it gets: compare body.measurements with the request (`drape body` names such keys).
 struct BodyBuildOptions {
   float grid_step = 0.011f;  // polygonisation step (metres): ~30k triangles at the default
   int max_fit_iterations = 8;

@@ -347,13 +347,25 @@ Mesh polygonise_model(const Model& model, float step) {
   throw std::runtime_error("body generator: could not polygonise a closed surface");
 }
 
-float worst_error(const MeasurementRequest& given, const Measurements& m) {
+// How far a body is from the request: the worst key, and the sum of what each key misses beyond
+// 8 mm. Shapes are ranked by the sum first, so that one key the shape cannot reach (it stays off
+// whatever the controls do) does not hide the others.
+struct FitError {
   float worst = 0;
+  float excess = 0;
+  bool operator<(const FitError& o) const { return excess != o.excess ? excess < o.excess : worst < o.worst; }
+};
+
+FitError fit_error(const MeasurementRequest& given, const Measurements& m) {
+  FitError e;
   for (const auto& row : measurement_table()) {
     const auto it = given.find(row.key);
-    if (it != given.end()) worst = std::max(worst, std::abs(it->second - m.*row.field));
+    if (it == given.end()) continue;
+    const float off = std::abs(it->second - m.*row.field);
+    e.worst = std::max(e.worst, off);
+    e.excess += std::max(0.0f, off - 0.008f);
   }
-  return worst;
+  return e;
 }
 
 }  // namespace
@@ -431,32 +443,32 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
   // if the fine mesh measures differently.
   Shape shape = initial_shape(sex, r);
   Shape best_shape = shape;
-  float best_error = std::numeric_limits<float>::max();
+  FitError best_error{std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   const float coarse = std::max(options.grid_step, 0.014f);
   for (int it = 0; it < options.max_fit_iterations; ++it) {
     const Mesh mesh = polygonise_model(build_model(shape), coarse);
     const Measurements m = measure_body(mesh, find_landmarks(mesh, "generated body"));
-    const float error = worst_error(given, m);
+    const FitError error = fit_error(given, m);
     if (error < best_error) {
       best_error = error;
       best_shape = shape;
     }
-    if (error < 0.002f) break;
+    if (error.worst < 0.002f) break;
     correct(shape, r, given, m);
   }
   Body body;
   body.sex = sex;
   shape = best_shape;
-  best_error = std::numeric_limits<float>::max();
+  best_error = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   for (int pass = 0; pass < 2; ++pass) {
     Mesh mesh = polygonise_model(build_model(shape), options.grid_step);
     const Measurements m = measure_body(mesh, find_landmarks(mesh, "generated body"));
-    const float error = worst_error(given, m);
+    const FitError error = fit_error(given, m);
     if (error < best_error) {
       best_error = error;
       body.mesh = std::move(mesh);
     }
-    if (error < 0.004f) break;
+    if (error.worst < 0.004f) break;
     correct(shape, r, given, m);
   }
   body.mesh.name = "body";

@@ -372,6 +372,14 @@ TEST(BodyCommand, WritesRiggedGlbAndRefusesBadMeasurements) {
   ASSERT_EQ(measured.exit_code, 0) << measured.err;
   EXPECT_NEAR(nlohmann::json::parse(measured.out)["measurements"]["hips"].get<double>(), 1.00, 0.01);
 
+  // Shoulders far narrower than a large chest allows: built, and the key is named as approximate.
+  const auto narrow = drape::test::run_drape("body --grid 0.02 --measurements bust=1.14,shoulder_width=0.30 -o " +
+                                             (dir / "narrow.glb").string());
+  ASSERT_EQ(narrow.exit_code, 0) << narrow.err;
+  EXPECT_NE(narrow.err.find("fitted approximately: shoulder_width"), std::string::npos) << narrow.err;
+  EXPECT_FALSE(nlohmann::json::parse(narrow.out)["measurements"]["shoulder_width"]["within_1cm"].get<bool>());
+  EXPECT_TRUE(nlohmann::json::parse(narrow.out)["measurements"]["bust"]["within_1cm"].get<bool>());
+
   const auto bad = drape::test::run_drape("body --measurements waist=7.4 -o " + (dir / "bad.glb").string());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--measurements"), std::string::npos) << bad.err;

@@ -40,7 +40,7 @@ struct DressOptions {
   // Draping: gravity on until settled, for at most `max_drape_seconds`, with viscous damping
   // `drape_damping` (1/s; quasi-static draping: it changes how fast the rest shape is reached, not
   // the rest shape).
-  double max_drape_seconds = 2.0;
+  double max_drape_seconds = 3.0;
   float drape_damping = 10.0f;
   // Settled: no vertex's net displacement over a window of `settle_window_s` of simulated time
   // exceeds `settle_distance_m` (an average speed below 1 cm/s for every vertex).

@@ -115,7 +115,14 @@ GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh,
   }
   const float k_seam = out.seam_pairs.empty() ? 0.0f
       : static_cast<float>(kSewingRate * kSewingRate * total_mass / static_cast<double>(out.seam_pairs.size()));
-  for (const auto& [a, b] : out.seam_pairs) spec.springs.push_back({a, b, 0.0f, k_seam, SpringKind::Seam});
+  // A pair of light vertices (an outline corner of the grid) gets at most sixteen times its own
+  // pair's stiffness at that rate (k = 16 w^2 m_a m_b / (m_a + m_b), i.e. it closes at <= 4 w), so
+  // it cannot outrun the step, yet it keeps up with its heavier neighbours.
+  for (const auto& [a, b] : out.seam_pairs) {
+    const double reduced = static_cast<double>(spec.mass[a]) * spec.mass[b] / (static_cast<double>(spec.mass[a]) + spec.mass[b]);
+    const float k = std::min(k_seam, static_cast<float>(16.0 * kSewingRate * kSewingRate * reduced));
+    spec.springs.push_back({a, b, 0.0f, k, SpringKind::Seam});
+  }
   spec.limited_kinds = (1u << static_cast<unsigned>(SpringKind::Structural)) | (1u << static_cast<unsigned>(SpringKind::Seam));
   return out;
 }

@@ -101,22 +101,32 @@ INSTANTIATE_TEST_SUITE_P(Garments, EveryBuiltin, ::testing::ValuesIn(builtin_nam
 
 // The default shirt on the MakeHuman-derived bodies and on GarmentCode's mean body (metres, +Y up).
 class SharedBody : public ::testing::TestWithParam<std::string> {};
+std::string body_stem(const ::testing::TestParamInfo<std::string>& p) {
+  return std::filesystem::path(p.param).stem().string();
+}
 
-// NOT YET REACHED: needs the gates of the default shirt first.
-TEST_P(SharedBody, DISABLED_DefaultShirt) {
+TEST_P(SharedBody, DefaultShirt) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const auto path = DRAPE_REQUIRE_SHARED(GetParam());
   expect_dressed(load_body(path), default_garment_name(), "");
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBody,
                          ::testing::Values("bodies/garmentcode/mean_all.obj", "bodies/makehuman/derived/mh_female_average.obj",
-                                           "bodies/makehuman/derived/mh_female_heavy.obj",
-                                           "bodies/makehuman/derived/mh_male_average.obj",
+                                           "bodies/makehuman/derived/mh_female_heavy.obj"),
+                         body_stem);
+
+// NOT YET REACHED on the male MakeHuman bodies: one seam stays 8-9 cm open (their shoulders and
+// arms are wider than the pattern's), see docs/dressing.md.
+class SharedMaleBody : public SharedBody {};
+TEST_P(SharedMaleBody, DISABLED_DefaultShirt) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const auto path = DRAPE_REQUIRE_SHARED(GetParam());
+  expect_dressed(load_body(path), default_garment_name(), "");
+}
+INSTANTIATE_TEST_SUITE_P(Bodies, SharedMaleBody,
+                         ::testing::Values("bodies/makehuman/derived/mh_male_average.obj",
                                            "bodies/makehuman/derived/mh_male_thin.obj"),
-                         [](const auto& p) {
-                           std::string n = std::filesystem::path(p.param).stem().string();
-                           return n;
-                         });
+                         body_stem);
 
 // Layers: a skirt, then a shirt over it (outermost last); the shirt must not sink into the skirt.
 TEST(DressScene, TwoLayers) {

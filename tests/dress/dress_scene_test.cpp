@@ -10,29 +10,15 @@
 #include <mutex>
 
 #include "drape/dress.hpp"
+#include "dress/dress_support.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
 namespace {
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
-
-// Bodies are expensive to build: one of each per test program.
-const Body& cached_body(Sex sex) {
-  static std::map<Sex, Body> bodies;
-  static std::mutex mutex;
-  std::lock_guard lock(mutex);
-  auto it = bodies.find(sex);
-  if (it == bodies.end()) it = bodies.emplace(sex, default_body(sex)).first;
-  return it->second;
-}
-
-std::string failed_gates(const DressResult& r) {
-  std::string s;
-  for (const GateResult& g : r.gates)
-    if (!g.passed) s += g.name + " (" + g.detail + "); ";
-  return s;
-}
+using test::cached_body;
+using test::failed_gates;
+using test::sanitized;
 
 // What every dressing must already give: a finite state, the garment on the body and outside it,
 // above the floor, its seams pulled from wide open to (on average) nearly closed.

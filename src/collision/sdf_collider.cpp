@@ -11,6 +11,26 @@
 
 namespace drape::collision {
 
+// Every brick cell overlapping the box [lo, hi], clipped to the grid, visited by cell index.
+template <class Visit>
+void SdfCollider::for_each_brick(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const {
+  const float brick_size = voxel_ * kBrick;
+  int first[3], last[3];
+  for (int a = 0; a < 3; ++a) {
+    first[a] = std::max(0, static_cast<int>(std::floor((lo[a] - origin_[a]) / brick_size)));
+    last[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((hi[a] - origin_[a]) / brick_size)));
+  }
+  const auto nx = static_cast<size_t>(dims_[0]), ny = static_cast<size_t>(dims_[1]);
+  for (int z = first[2]; z <= last[2]; ++z)
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x)
+        visit((static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x));
+}
+
+size_t SdfCollider::memory_bytes() const {
+  return brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) + nearest_triangle_.size() * sizeof(uint32_t);
+}
+
 SdfCollider::SdfCollider(const Mesh& body, float voxel_size, float band)
     : surface_(body.positions, body.triangles), voxel_(voxel_size), band_(band) {
   if (!(voxel_size > 0) || !(band > 0)) throw std::invalid_argument("sdf collider: voxel size and band must be positive");
@@ -48,18 +68,9 @@ void SdfCollider::update_field() {
 
   const float brick_size = voxel_ * kBrick;
   const float reach = band_ + std::sqrt(3.0f) * brick_size + 2 * longest_edge_ + tolerance;
-  const size_t nx = static_cast<size_t>(dims_[0]), ny = static_cast<size_t>(dims_[1]);
   std::vector<uint8_t> dirty(brick_of_.size(), 0);
   const auto mark = [&](const Vec3f& p, float grow) {
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((p[a] - grow - origin_[a]) / brick_size)));
-      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((p[a] + grow - origin_[a]) / brick_size)));
-    }
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x)
-          dirty[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] = 1;
+    for_each_brick(p - Vec3f::Constant(grow), p + Vec3f::Constant(grow), [&](size_t c) { dirty[c] = 1; });
   };
   for (uint32_t v : moved) {
     // The moved surface must stay inside the grid and its band inside stored bricks.
@@ -77,16 +88,9 @@ void SdfCollider::update_field() {
     if (!vertex_moved[tri[0]] && !vertex_moved[tri[1]] && !vertex_moved[tri[2]]) continue;
     Bounds tb;
     for (uint32_t v : tri) tb.extend(positions[v]);
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((tb.min[a] - band_ - origin_[a]) / brick_size)));
-      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((tb.max[a] + band_ - origin_[a]) / brick_size)));
-    }
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x)
-          if (brick_of_[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] < 0)
-            brick_of_[(static_cast<size_t>(z) * ny + static_cast<size_t>(y)) * nx + static_cast<size_t>(x)] = kNewlyStored;
+    for_each_brick(tb.min - Vec3f::Constant(band_), tb.max + Vec3f::Constant(band_), [&](size_t c) {
+      if (brick_of_[c] < 0) brick_of_[c] = kNewlyStored;
+    });
   }
   // Bricks the moved surface now needs get sample blocks (in cell order) and are sampled below.
   for (size_t c = 0; c < brick_of_.size(); ++c)
@@ -103,8 +107,7 @@ void SdfCollider::update_field() {
   judge_far_bricks(flagged);
   for (uint32_t v : moved) sampled_positions_[v] = positions[v];
   stats_.rebuilt_fraction = stored_bricks_ ? static_cast<double>(stored.size()) / static_cast<double>(stored_bricks_) : 0.0;
-  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
-                        nearest_triangle_.size() * sizeof(uint32_t);
+  stats_.memory_bytes = memory_bytes();
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -116,24 +119,13 @@ void SdfCollider::build_field() {
   for (int a = 0; a < 3; ++a)
     dims_[a] = static_cast<int>(std::ceil((box.max[a] - box.min[a] + 2 * (band_ + voxel_)) / brick_size)) + 1;
   const size_t brick_cells = static_cast<size_t>(dims_[0]) * static_cast<size_t>(dims_[1]) * static_cast<size_t>(dims_[2]);
-  auto cell_index = [&](int x, int y, int z) {
-    return (static_cast<size_t>(z) * static_cast<size_t>(dims_[1]) + static_cast<size_t>(y)) * static_cast<size_t>(dims_[0]) +
-           static_cast<size_t>(x);
-  };
 
   // Bricks within the band of some triangle (its box grown by the band) store samples.
   brick_of_.assign(brick_cells, kFarOutside);
   for (const Tri& tri : surface_.triangles()) {
     Bounds tb;
     for (uint32_t v : tri) tb.extend(surface_.position(v));
-    int lo[3], hi[3];
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((tb.min[a] - band_ - origin_[a]) / brick_size)));
-      hi[a] = std::min(dims_[a] - 1, static_cast<int>(std::floor((tb.max[a] + band_ - origin_[a]) / brick_size)));
-    }
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x) brick_of_[cell_index(x, y, z)] = 0;
+    for_each_brick(tb.min - Vec3f::Constant(band_), tb.max + Vec3f::Constant(band_), [&](size_t c) { brick_of_[c] = 0; });
   }
   std::vector<size_t> stored_cells;
   for (size_t c = 0; c < brick_cells; ++c)
@@ -158,8 +150,7 @@ void SdfCollider::build_field() {
       longest_edge_ = std::max(longest_edge_, (surface_.position(tri[k]) - surface_.position(tri[(k + 1) % 3])).norm());
   stats_.rebuilt_fraction = 1;
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats_.memory_bytes = brick_of_.size() * sizeof(int32_t) + distance_.size() * sizeof(float) +
-                        nearest_triangle_.size() * sizeof(uint32_t);
+  stats_.memory_bytes = memory_bytes();
 }
 
 // Exact signed samples of stored bricks (given by brick cell), in parallel: each brick independent.

@@ -37,6 +37,9 @@ class SdfCollider final : public BodyCollider {
   void sample_bricks(const std::vector<size_t>& cells);
   void judge_far_bricks(const std::vector<size_t>& cells);
   ContactSample sample(const Vec3f& p, float radius) const;
+  template <class Visit>
+  void for_each_brick(const Vec3f& lo, const Vec3f& hi, Visit&& visit) const;
+  size_t memory_bytes() const;
 
   BodySurface surface_;
   std::unique_ptr<TriangleBvh> bvh_;

@@ -43,6 +43,17 @@ bool collect_triangle(RTCPointQueryFunctionArguments* args) {
   return false;
 }
 
+// An Embree point query: everything within `radius` of p.
+RTCPointQuery point_query(const Vec3f& p, float radius) {
+  RTCPointQuery query;
+  query.x = p.x();
+  query.y = p.y();
+  query.z = p.z();
+  query.time = 0.0f;
+  query.radius = radius;
+  return query;
+}
+
 }  // namespace
 
 TriangleBvh::TriangleBvh(const BodySurface& surface, bool refit) : surface_(surface) {
@@ -109,12 +120,7 @@ bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
 
 void TriangleBvh::within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const {
   triangles.clear();
-  RTCPointQuery query;
-  query.x = p.x();
-  query.y = p.y();
-  query.z = p.z();
-  query.time = 0.0f;
-  query.radius = radius;
+  RTCPointQuery query = point_query(p, radius);
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   WithinState state{&surface_, &triangles};
@@ -124,12 +130,7 @@ void TriangleBvh::within(const Vec3f& p, float radius, std::vector<uint32_t>& tr
 }
 
 bool TriangleBvh::closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const {
-  RTCPointQuery query;
-  query.x = p.x();
-  query.y = p.y();
-  query.z = p.z();
-  query.time = 0.0f;
-  query.radius = radius;
+  RTCPointQuery query = point_query(p, radius);
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   QueryState state{&surface_, &hit, false};

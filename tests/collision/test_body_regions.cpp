@@ -11,6 +11,7 @@
 
 #include "drape/collision.hpp"
 #include "drape/io.hpp"
+#include "collision/image_pair.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
@@ -54,12 +55,11 @@ RegionScore score(const BodyCollider& collider, const InsideTest& truth, const s
 
 TEST(HiddenRegions, PlainImageMapsFailWhereTheHandlingIsRight) {
   const auto path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
-  const Mesh body = read_mesh(path);
-  const InsideTest truth(body);
-  BodyColliderOptions plain_options, handled_options;
-  plain_options.hidden_region_handling = false;
-  const auto plain = make_body_collider(body, CollisionMethod::image, plain_options);
-  const auto handled = make_body_collider(body, CollisionMethod::image, handled_options);
+  const test::ImageCollidersWithTruth colliders(path);
+  const Mesh& body = colliders.body;
+  const InsideTest& truth = colliders.truth;
+  const auto& plain = colliders.plain;
+  const auto& handled = colliders.handled;
   // mean_all (A-pose, 1.72 m). Where the plain maps fail (found with DRAPE_REGION_MAP=1, which
   // prints the failure rate per 5 cm cell): under the chin, the hands and fingers (several layers),
   // the feet (tops and soles seen edge-on). In this A-pose the armpits and the crotch are open

@@ -12,6 +12,7 @@
 
 #include "drape/collision.hpp"
 #include "drape/io.hpp"
+#include "collision/image_pair.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
@@ -63,12 +64,11 @@ float gap_top(const InsideTest& truth, float x, float y0, float z) {
 // crotch: x = 0 at the legs' mid-depth.
 TEST(HiddenRegions, StripPulledIntoArmpitAndCrotchIsCaught) {
   const auto path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
-  const Mesh body = read_mesh(path);
-  const InsideTest truth(body);
-  BodyColliderOptions plain_options, handled_options;
-  plain_options.hidden_region_handling = false;
-  const auto plain = make_body_collider(body, CollisionMethod::image, plain_options);
-  const auto handled = make_body_collider(body, CollisionMethod::image, handled_options);
+  const test::ImageCollidersWithTruth colliders(path);
+  const Mesh& body = colliders.body;
+  const InsideTest& truth = colliders.truth;
+  const auto& plain = colliders.plain;
+  const auto& handled = colliders.handled;
 
   float torso_z = 0, legs_z = 0;
   int torso_n = 0, legs_n = 0;

@@ -16,6 +16,10 @@ struct PlacedPanels {
 };
 PlacedPanels place_panels(const Body& body, const Garment& garment, const GarmentMesh& mesh,
                           const Collider& body_collider, float collision_thickness);
+// Imported panels that carry the file's 3D placement (placement_from_file.cpp): hints and panel
+// orientation read from it, then rolled as above. place_panels calls it when every panel has one.
+PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, const GarmentMesh& mesh,
+                                    const Collider& body_collider, float collision_thickness);
 
 // Stage 4 (garment_model.cpp): one cloth spec for all panels (grid topology springs where the
 // grid mesher made the panel, triangle-mesh springs otherwise) and zero-length seam springs.

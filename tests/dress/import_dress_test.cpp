@@ -6,8 +6,11 @@
 // Each must pass the quality gates of docs/dressing.md: seams closed (<= 2 mm), <= 0.5 % of the
 // vertices inside the body, max strain <= the fabric's threshold + 1 %, settled, above the floor,
 // stayed on. Skipped under sanitizers (DRAPE_SANITIZED): each dressing takes seconds in Release.
+// Imports are also checked where placement puts them (from the file's own 3D layout, on mean_all)
+// and through their first sewing steps, and `drape dress` must refuse malformed imports.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
@@ -147,12 +150,101 @@ const Body& mean_all_body(const std::filesystem::path& path) {
 }
 
 class ImportedPattern : public ::testing::TestWithParam<std::string> {};
+class ImportedPlacement : public ::testing::TestWithParam<std::string> {};
+
+// The file's 3D layout, where a panel's centre lies (p = R (x, y, 0) + T, in metres).
+Vec3f file_centre(const Panel& panel) {
+  const PanelTransform& t = *panel.transform;
+  constexpr double kDeg = 3.14159265358979323846 / 180;
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd(t.rotation_deg.z() * kDeg, Vec3d::UnitZ()) *
+                             Eigen::AngleAxisd(t.rotation_deg.y() * kDeg, Vec3d::UnitY()) *
+                             Eigen::AngleAxisd(t.rotation_deg.x() * kDeg, Vec3d::UnitX()))
+                                .toRotationMatrix();
+  Vec3d c = Vec3d::Zero();
+  const auto loop = panel.polygon(0.01);
+  for (const Vec2d& q : loop) c += r * Vec3d(q.x(), q.y(), 0);
+  return (c / static_cast<double>(loop.size()) + t.translation).cast<float>();
+}
+
+// Placement from the file's own 3D layout: every vertex outside the body and at least a millimetre
+// from it, each panel on the side of the body where the file puts it (left/right of the midline,
+// in front of/behind the body's centre, where the file's centre is more than 5 cm off), the flat
+// pattern hardly stretched, and the first sewing steps finite with the seams closing (before it
+// was read, the importer's guessed hints mirrored clockwise back panels across the body and the
+// sewing exploded in its first step).
+TEST_P(ImportedPlacement, StartsClearOfTheBodyWhereTheFilePutsIt) {
+  if (sanitized() && GetParam().find("shirt") == std::string::npos)
+    GTEST_SKIP() << "sanitized build: the GarmentCode shirt only";
+  const auto body_path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
+  const auto pattern = DRAPE_REQUIRE_SHARED("patterns/" + GetParam());
+  const Body& body = mean_all_body(body_path);
+  const Garment garment = garment_in_size(load_garment(pattern.string()), "");
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::image);
+  DressOptions o;
+  o.simulate = false;
+  const DressedGarment g = prepare_garment(body, garment, *collider, o);
+  const InsideTest inside(body.mesh);
+  const GarmentMeasure m = measure_garment(g.model, g.state.x, inside);
+  EXPECT_EQ(m.penetration.penetrating, 0u);
+  // Rolled with flat y as height where a garment has sleeves, the springs of a shirt stretch over
+  // the sloped shoulders (p99 measured: shirt 0.44, tee 0.51, hoody 0.35, pants 0.16, flare skirt
+  // 0.13; the built-in shirt 0.18 with the same roll); the first sewing steps relax it.
+  EXPECT_LE(m.strain.p99, 0.6f);
+  const float centre_z = 0.5f * (body.landmarks.waist.z() + body.landmarks.hip.z());
+  for (size_t p = 0; p < garment.panels.size(); ++p) {
+    SCOPED_TRACE(garment.panels[p].name);
+    EXPECT_NE(g.placement[p].region.find("transform"), std::string::npos);
+    Vec3f mean = Vec3f::Zero();
+    for (uint32_t v = g.panel_first_vertex[p]; v < g.panel_first_vertex[p + 1]; ++v) {
+      EXPECT_GT(inside.unsigned_distance(g.state.x[v]), 0.001f);
+      mean += g.state.x[v];
+    }
+    mean /= static_cast<float>(g.panel_first_vertex[p + 1] - g.panel_first_vertex[p]);
+    const Vec3f file = file_centre(garment.panels[p]);
+    if (std::abs(file.x()) > 0.05f) {
+      EXPECT_EQ(mean.x() > 0, file.x() > 0);
+    }
+    if (std::abs(file.z() - centre_z) > 0.05f) {
+      EXPECT_EQ(mean.z() > centre_z, file.z() > centre_z);
+    }
+  }
+
+  // The first sewing steps: finite, and the widest seam closing.
+  if (sanitized()) return;
+  o.simulate = true;
+  o.max_iterations = 400;
+  const DressResult r = dress(body, {{load_garment(pattern.string()), ""}}, o);
+  ASSERT_EQ(r.garments.size(), 1u);
+  EXPECT_TRUE(r.quality.finite);
+  EXPECT_EQ(r.garments[0].status, StepStatus::Ok);
+  EXPECT_LT(r.quality.max_seam_gap_m, 0.8f * r.garments[0].initial_max_gap);
+}
 
 TEST_P(ImportedPattern, PassesTheGatesOnMeanAll) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: dressing takes too long";
   const auto body_path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
   const auto pattern = DRAPE_REQUIRE_SHARED("patterns/" + GetParam());
   expect_gates(dress(mean_all_body(body_path), {{load_garment(pattern.string()), ""}}));
+}
+
+// `drape dress --garment FILE` on a malformed import (the corpus's GarmentCode and 2021 files):
+// exit 2, one stderr line naming the file, nothing written.
+TEST(ImportedPatternCli, MalformedImportsAreRefusedAndNothingWritten) {
+  const std::filesystem::path corpus = std::filesystem::path(DRAPE_SOURCE_DIR) / "tests/corpus/garment";
+  size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(corpus)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("garmentcode_", 0) != 0 && name.rfind("template2021_", 0) != 0) continue;
+    SCOPED_TRACE(name);
+    ++files;
+    const auto out = test::temp_dir("import_cli") / "out";
+    const auto r = test::run_drape("dress --garment " + entry.path().string() + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(entry.path().string()), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  EXPECT_GE(files, 3u);
 }
 
 std::string pattern_case_name(const ::testing::TestParamInfo<std::string>& info) {
@@ -163,16 +255,27 @@ std::string pattern_case_name(const ::testing::TestParamInfo<std::string>& info)
   return s;
 }
 
-// NOT YET REACHED (DISABLED_ prefix, as above): measured failures are listed in docs/dressing.md.
-INSTANTIATE_TEST_SUITE_P(DISABLED_GarmentCode, ImportedPattern,
-                         ::testing::Values("garmentcode/shirt_mean_specification.json",
-                                           "garmentcode/dress_pencil_specification.json",
-                                           "garmentcode/flare_skirt_specification.json",
-                                           "garmentcode/hoody_mean_specification.json",
-                                           "garment_pattern_generator_2021/tee.json",
-                                           "garment_pattern_generator_2021/skirt_4_panels.json",
-                                           "garment_pattern_generator_2021/pants_straight_sides.json"),
-                         pattern_case_name);
+const auto kImportedPatterns = ::testing::Values("garmentcode/shirt_mean_specification.json",
+                                                 "garmentcode/dress_pencil_specification.json",
+                                                 "garmentcode/flare_skirt_specification.json",
+                                                 "garmentcode/hoody_mean_specification.json",
+                                                 "garment_pattern_generator_2021/tee.json",
+                                                 "garment_pattern_generator_2021/skirt_4_panels.json",
+                                                 "garment_pattern_generator_2021/pants_straight_sides.json");
+
+INSTANTIATE_TEST_SUITE_P(Files, ImportedPlacement, kImportedPatterns, pattern_case_name);
+
+// NOT YET REACHED (DISABLED_ prefix, as above), measured at 17:10 UTC on mean_all with the
+// placement from the file (docs/dressing.md, Imports): no explosion any more, but
+//   shirt_mean: shoulder and overarm seams 24-52 mm open where front, back and both sleeve halves
+//     meet, strain 5.6 % (cotton 5 %), not settled;
+//   dress_pencil: shoulder/side corners and skirt-bodice seam 50-87 mm open, strain 8.7 %;
+//   flare_skirt: every seam closed, but the waistband slides down the hips and off (drop 0.79 m);
+//   hoody_mean: the hood's centre seams 108-116 mm open (the hood rolled on the torso's surface);
+//   tee (2021): side seams 100 mm open: 0.87 m round the chest on a 1.01 m bust (SMPL-sized);
+//   skirt_4_panels (2021): tilted side panels stretched 28 %, seams 38 mm open;
+//   pants_straight_sides (2021): crotch and inseams 34-156 mm open (SMPL-sized hips on mean_all).
+INSTANTIATE_TEST_SUITE_P(DISABLED_GarmentCode, ImportedPattern, kImportedPatterns, pattern_case_name);
 
 }  // namespace
 }  // namespace drape

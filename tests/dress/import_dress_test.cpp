@@ -266,7 +266,7 @@ const auto kImportedPatterns = ::testing::Values("garmentcode/shirt_mean_specifi
 INSTANTIATE_TEST_SUITE_P(Files, ImportedPlacement, kImportedPatterns, pattern_case_name);
 
 // NOT YET REACHED (DISABLED_ prefix, as above), measured at 17:10 UTC on mean_all with the
-// placement from the file (docs/dressing.md, Imports): no explosion any more, but
+// placement from the file (docs/garment-format.md, Dressing an import): no explosion, but
 //   shirt_mean: shoulder and overarm seams 24-52 mm open where front, back and both sleeve halves
 //     meet, strain 5.6 % (cotton 5 %), not settled;
 //   dress_pencil: shoulder/side corners and skirt-bodice seam 50-87 mm open, strain 8.7 %;

@@ -8,6 +8,9 @@
 #include <cstdlib>
 #include <map>
 #include <mutex>
+#include <ostream>
+#include <string>
+#include <vector>
 
 #include "drape/dress.hpp"
 #include "dress/dress_support.hpp"
@@ -75,25 +78,50 @@ TEST(DressScene, ShirtOtherSizesOnDefaultBody) {
   for (const char* size : {"S", "L"}) expect_dressed(cached_body(Sex::Female), "shirt", size);
 }
 
-class EveryBuiltin : public ::testing::TestWithParam<std::string> {};
+// A built-in garment in one size on one default body.
+struct Fit {
+  std::string garment, size;
+  Sex sex;
+};
+void PrintTo(const Fit& f, std::ostream* os) { *os << f.garment << ' ' << f.size << (f.sex == Sex::Female ? " female" : " male"); }
+std::string fit_name(const ::testing::TestParamInfo<Fit>& p) {
+  return p.param.garment + "_" + p.param.size + (p.param.sex == Sex::Female ? "_female" : "_male");
+}
 
-// NOT YET REACHED: trousers and dress still explode from their placement (see docs/dressing.md).
-TEST_P(EveryBuiltin, DISABLED_EverySizeOnBothDefaultBodies) {
+// Every gate passed (the shirt's S/M/L on the female body are asserted above).
+class BuiltinFit : public ::testing::TestWithParam<Fit> {};
+TEST_P(BuiltinFit, PassesTheGates) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
-  const GarmentSpec spec = load_garment(GetParam());
-  for (Sex sex : {Sex::Female, Sex::Male}) {
-    SCOPED_TRACE(sex == Sex::Female ? "female body" : "male body");
-    for (const std::string& size : spec.sizes) expect_dressed(cached_body(sex), GetParam(), size);
-  }
+  expect_dressed(cached_body(GetParam().sex), GetParam().garment, GetParam().size);
 }
+INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
+                         ::testing::Values(Fit{"dress", "M", Sex::Female}, Fit{"dress", "L", Sex::Female}), fit_name);
 
-std::vector<std::string> builtin_names() {
-  std::vector<std::string> names;
-  for (const BuiltinGarment& g : builtin_garments()) names.push_back(g.name);
-  return names;
+// NOT YET REACHED (measured failures, see docs/dressing.md "Status"):
+// - shirt XL (men's cut) on the male body: seams closed, strain 7.0 % (limit 6 %) at the back
+//   armholes and the pinched sleeve underarm; S/M/L on the male body: a shoulder/armhole corner
+//   10-20 mm open (the female-graded shoulders end on his acromions);
+// - dress S on the female body: side and shoulder seams 11 mm open, not settled; dress on the
+//   male body: shoulder seams 26-28 mm open at his wider neck;
+// - jeans: the outseam at the hip 10-34 mm open (inseams closed, strain 2.3 %, limit 3 %);
+// - skirt: the waistband creeps on the hips (strain over the limit, not settled), S/M cannot
+//   close on the male waist; trousers: the hips stretched past wool's limit.
+class BuiltinNotYet : public BuiltinFit {};
+TEST_P(BuiltinNotYet, DISABLED_PassesTheGates) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  expect_dressed(cached_body(GetParam().sex), GetParam().garment, GetParam().size);
 }
-INSTANTIATE_TEST_SUITE_P(Garments, EveryBuiltin, ::testing::ValuesIn(builtin_names()),
-                         [](const auto& p) { return p.param; });
+std::vector<Fit> not_yet() {
+  std::vector<Fit> fits = {{"shirt", "XL", Sex::Male}, {"dress", "S", Sex::Female}};
+  for (const char* size : {"S", "M", "L"}) {
+    fits.push_back({"shirt", size, Sex::Male});
+    fits.push_back({"dress", size, Sex::Male});
+    for (const char* garment : {"skirt", "trousers", "jeans"})
+      for (Sex sex : {Sex::Female, Sex::Male}) fits.push_back({garment, size, sex});
+  }
+  return fits;
+}
+INSTANTIATE_TEST_SUITE_P(Garments, BuiltinNotYet, ::testing::ValuesIn(not_yet()), fit_name);
 
 // The default shirt on the MakeHuman-derived bodies and on GarmentCode's mean body (metres, +Y up).
 class SharedBody : public ::testing::TestWithParam<std::string> {};

@@ -2,10 +2,11 @@
 // the Korosteleva 2021 templates, ../shared/data/patterns/FORMAT_NOTES.md sections 1-2): each panel
 // is a flat sheet put at p = R (x, y, 0) + T around the body the pattern was designed on.
 //
-// Flat sheets at the file's positions are far from the body on one side and inside it on another
-// (a shirt's front halves lie in the plane z = 25 cm, crossing an A-posed arm), so the file's
-// placement is not used as positions. It is read as what it means and the panels are then rolled
-// by the torso/limb roll of placement.cpp, at a clearance, at the file's position:
+// A garment without sleeves whose flat sheets lie clear of the body starts from the file's layout
+// as it is (GarmentCode's own start). Otherwise flat sheets would have to close their seams across
+// the A-posed arms (a shirt's side seams run in front of and behind them), so the file's placement
+// is read as what it means and the panels are rolled by the torso/limb roll of placement.cpp, at a
+// clearance, at the file's position:
 //   - the region a panel wraps: an arm where its centre lies beyond the shoulders and above the
 //     hips, a trouser leg where it stays on one side of the midline and reaches below the crotch,
 //     else the torso;
@@ -41,6 +42,9 @@ constexpr double kTemplateArmAngleDeg = 0.0;
 // templates' waistbands lie 5 cm below their origin (skirts, pants) and the tee's shoulder-neck
 // points 29 cm above it.
 constexpr double kPelvisAboveWaist = 0.05;
+
+// A flat layout is used as it is only where every vertex lies this far off the body.
+constexpr float kFlatClearance = 0.01f;
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
@@ -144,6 +148,7 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
   constexpr double kMidlineSlack = 0.03;  // a trouser panel's crotch extension may cross the midline
 
   // A copy of the garment with hints derived from the file, and its meshes in rolled coordinates.
+  bool any_arm = false;
   Garment rolled = garment;
   GarmentMesh rolled_mesh = mesh;
   for (size_t p = 0; p < garment.panels.size(); ++p) {
@@ -181,6 +186,7 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       const bool front_back = h.side == PanelSide::front || h.side == PanelSide::back;
       h.anchor.x() = front_back && std::abs(f.across.x()) > 0.1 ? -f.origin.x() / f.across.x() : 0.5 * (f.x_lo + f.x_hi);
     }
+    any_arm = any_arm || region == BodyRegion::left_arm || region == BodyRegion::right_arm;
     rolled.panels[p].placement = h;
     rolled.panels[p].transform.reset();
 
@@ -191,8 +197,36 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
     }
   }
 
+  // A GarmentCode garment without sleeves whose flat sheets already lie clear of the body starts
+  // from the file's own layout, as GarmentCode's simulator starts it: its seams close around the
+  // body without crossing a limb (measured on mean_all: the hoody's seams all close from there,
+  // rolled its side seams stay 11 cm open). With sleeves the flat side and underarm seams would
+  // have to close across the A-posed arms, and the 2021 templates were laid out around another
+  // body in another pose: those are rolled.
+  if (!pelvis_origin && !any_arm) {
+    PlacedPanels out;
+    out.positions.resize(garment.panels.size());
+    out.info.resize(garment.panels.size());
+    std::vector<ContactSample> contact;
+    bool clear = true;
+    for (size_t p = 0; p < garment.panels.size() && clear; ++p) {
+      const Panel& panel = garment.panels[p];
+      const Eigen::Matrix3d r = rotation_of(*panel.transform);
+      auto& x = out.positions[p];
+      for (const Vec3f& q : mesh.panels[p].mesh.positions) {
+        const Vec3d d = r * Vec3d(q.x(), q.y(), 0) + panel.transform->translation;
+        x.push_back(to_f(Vec3d(d.x(), frame.height(d.y()), d.z())));
+      }
+      contact.resize(x.size());
+      body_collider.query(x, kFlatClearance, contact);
+      for (const ContactSample& c : contact) clear = clear && c.distance >= kFlatClearance;
+      out.info[p] = {panel.name, "transform: flat, as in the file", kFlatClearance, 0};
+    }
+    if (clear) return out;
+  }
+
   PlacedPanels out = place_panels(body, rolled, rolled_mesh, body_collider, collision_thickness);
-  for (PanelPlacement& info : out.info) info.region = "transform: " + info.region;
+  for (PanelPlacement& info : out.info) info.region = "transform: rolled on " + info.region;
   return out;
 }
 

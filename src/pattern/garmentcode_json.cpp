@@ -84,7 +84,10 @@ GarmentSpec parse_garmentcode(const Json& root, const std::string& source) {
   spec.format = is_2021 ? "garmentcode-2021" : "garmentcode";
   spec.name = std::filesystem::path(source).stem().string();
   spec.sizes = {"as drafted"};
-  spec.fabric = "cotton";
+  // Neither format names a fabric. GarmentCode's simulator drapes every pattern in one very soft,
+  // stretchy material (default_sim_props.yaml: garment_edge_ke 1.0, "Very soft fabric") and its
+  // patterns have little ease, so its specifications get the knit preset; the 2021 templates cotton.
+  spec.fabric = is_2021 ? "cotton" : "jersey";
 
   // Panel order: panel_order where given, else file order.
   std::vector<std::string> order;

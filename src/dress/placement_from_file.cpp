@@ -149,6 +149,7 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
 
   // A copy of the garment with hints derived from the file, and its meshes in rolled coordinates.
   bool any_arm = false;
+  std::vector<double> rise(garment.panels.size(), 0.0);  // body height per unit of rolled y
   Garment rolled = garment;
   GarmentMesh rolled_mesh = mesh;
   for (size_t p = 0; p < garment.panels.size(); ++p) {
@@ -181,8 +182,8 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       const bool top = f.world_y_hi > armpit_y && region == BodyRegion::torso;
       h.landmark = top ? Landmark::shoulder : Landmark::waist;
       const double target = top ? 0.5 * (l.left_shoulder.y() + l.right_shoulder.y()) : l.waist.y();
-      const double rise = frame.scale * f.up.y();
-      h.anchor.y() = rise > 1e-3 ? (target - f.origin.y()) / rise : f.y_top;
+      rise[p] = frame.scale * f.up.y();
+      h.anchor.y() = rise[p] > 1e-3 ? (target - f.origin.y()) / rise[p] : f.y_top;
       const bool front_back = h.side == PanelSide::front || h.side == PanelSide::back;
       h.anchor.x() = front_back && std::abs(f.across.x()) > 0.1 ? -f.origin.x() / f.across.x() : 0.5 * (f.x_lo + f.x_hi);
     }
@@ -196,6 +197,18 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       q = to_f(Vec3d(d.dot(f.across), d.dot(f.up), 0.0));
     }
   }
+
+  // With sleeves the roll has no roof over the shoulders, only a 4 cm lift of panels anchored
+  // there, which would move the torso above the sleeves' heights: the file's heights are where
+  // the garment hangs, so such panels are anchored at the waist (measured on mean_all: the
+  // GarmentCode shirt's shoulder seams close from the file's heights, 15 mm stay open 4 cm higher).
+  if (any_arm)
+    for (size_t p = 0; p < rolled.panels.size(); ++p) {
+      PlacementHint& h = *rolled.panels[p].placement;
+      if (h.landmark != Landmark::shoulder || h.body_part != BodyRegion::torso || rise[p] <= 1e-3) continue;
+      h.landmark = Landmark::waist;
+      h.anchor.y() += (l.waist.y() - 0.5 * (l.left_shoulder.y() + l.right_shoulder.y())) / rise[p];
+    }
 
   // A GarmentCode garment without sleeves whose flat sheets already lie clear of the body starts
   // from the file's own layout, as GarmentCode's simulator starts it: its seams close around the

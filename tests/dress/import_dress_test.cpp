@@ -291,5 +291,37 @@ INSTANTIATE_TEST_SUITE_P(DISABLED_GarmentCode, ImportedPattern,
                                            "garment_pattern_generator_2021/pants_straight_sides.json"),
                          pattern_case_name);
 
+// --- The 2021 templates on a body of our choice --------------------------------------------------
+
+// The templates were drafted around the SMPL female average body, which is not in the data: a slim
+// 1.70 m female body built from measurements stands in for it (mean_all is 1.01 m round the bust
+// against the tee's 0.87 m).
+const Body& template_body() {
+  static const Body body = make_body(Sex::Female, {{"height", 1.70f}, {"bust", 0.82f}, {"waist", 0.66f}, {"hips", 0.90f}});
+  return body;
+}
+
+class Template2021 : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Template2021, PassesTheGatesOnASlimBody) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: dressing takes too long";
+  const auto pattern = DRAPE_REQUIRE_SHARED("patterns/" + GetParam());
+  expect_gates(dress(template_body(), {{load_garment(pattern.string()), ""}}));
+}
+
+// Passes every gate (measured 17:00 UTC): seams 0.01 mm, strain 5.5 % (cotton, limit 6 %), 0 inside,
+// settled after ~3000 iterations, dropped 9 cm while draping.
+INSTANTIATE_TEST_SUITE_P(Skirt, Template2021, ::testing::Values("garment_pattern_generator_2021/skirt_4_panels.json"),
+                         pattern_case_name);
+
+// NOT YET REACHED (measured 17:00 UTC on the same body): the tee's shoulder seams stay 90 mm open
+// (its T-pose sleeves pull the shoulders down on an A-posed body; 35 mm on mh_female_average); the
+// trousers' waist is 1.20 m round (no darts or band, wider than any hips here), so they close every
+// seam and slide off the body.
+INSTANTIATE_TEST_SUITE_P(DISABLED_TeeAndTrousers, Template2021,
+                         ::testing::Values("garment_pattern_generator_2021/tee.json",
+                                           "garment_pattern_generator_2021/pants_straight_sides.json"),
+                         pattern_case_name);
+
 }  // namespace
 }  // namespace drape

@@ -265,7 +265,7 @@ const auto kImportedPatterns = ::testing::Values("garmentcode/shirt_mean_specifi
 
 INSTANTIATE_TEST_SUITE_P(Files, ImportedPlacement, kImportedPatterns, pattern_case_name);
 
-// Pass every gate (measured 16:53 UTC), in jersey (GarmentCode's soft default material): the
+// Pass every gate (measured 16:50 UTC), in jersey (GarmentCode's soft default material): the
 // hoody, started from the file's flat layout (seams 0.01 mm, strain 10.0 %, limit 11 %, 0 inside,
 // settled after ~1500 iterations), and the shirt, rolled at the file's heights (seams 0.01 mm,
 // strain 10.0 %, 0 inside, settled after ~3000 iterations).
@@ -274,7 +274,7 @@ INSTANTIATE_TEST_SUITE_P(GarmentCode, ImportedPattern,
                                            "garmentcode/hoody_mean_specification.json"),
                          pattern_case_name);
 
-// NOT YET REACHED (DISABLED_ prefix, as above), measured at 16:53 UTC on mean_all with the
+// NOT YET REACHED (DISABLED_ prefix, as above), measured at 16:50 UTC on mean_all with the
 // placement from the file (docs/garment-format.md, Dressing an import): no explosion, but
 //   dress_pencil (flat, jersey): every seam closed, but the dress slides down the body and off
 //     (drop 0.78 m), strain 13 %;
@@ -309,12 +309,12 @@ TEST_P(Template2021, PassesTheGatesOnASlimBody) {
   expect_gates(dress(template_body(), {{load_garment(pattern.string()), ""}}));
 }
 
-// Passes every gate (measured 17:00 UTC): seams 0.01 mm, strain 5.5 % (cotton, limit 6 %), 0 inside,
+// Passes every gate (measured 16:50 UTC): seams 0.01 mm, strain 5.5 % (cotton, limit 6 %), 0 inside,
 // settled after ~3000 iterations, dropped 9 cm while draping.
 INSTANTIATE_TEST_SUITE_P(Skirt, Template2021, ::testing::Values("garment_pattern_generator_2021/skirt_4_panels.json"),
                          pattern_case_name);
 
-// NOT YET REACHED (measured 17:00 UTC on the same body): the tee's shoulder seams stay 90 mm open
+// NOT YET REACHED (measured 16:50 UTC on the same body): the tee's shoulder seams stay 90 mm open
 // (its T-pose sleeves pull the shoulders down on an A-posed body; 35 mm on mh_female_average); the
 // trousers' waist is 1.20 m round (no darts or band, wider than any hips here), so they close every
 // seam and slide off the body.

@@ -81,6 +81,23 @@ TEST(Import, UnitsInMeter300AreRescaled) {
   EXPECT_NEAR(front->transform->translation.z(), 0.1876, 1e-9);
 }
 
+// The file's 3D placement is kept as written: translation in metres, XYZ Euler degrees. Neither
+// format names a fabric: GarmentCode's soft default material maps to jersey, the 2021 templates to cotton.
+TEST(Import, PlacementAsWrittenAndDefaultFabrics) {
+  const auto shirt_path = DRAPE_REQUIRE_SHARED("patterns/garmentcode/shirt_mean_specification.json");
+  const auto skirt_path = DRAPE_REQUIRE_SHARED("patterns/garment_pattern_generator_2021/skirt_4_panels.json");
+  const auto shirt = read_garment(shirt_path);
+  EXPECT_EQ(shirt.fabric, "jersey");
+  const auto sleeve = std::find_if(shirt.panels.begin(), shirt.panels.end(), [](const PanelSpec& p) { return p.name == "left_sleeve_f"; });
+  ASSERT_NE(sleeve, shirt.panels.end());
+  EXPECT_NEAR(sleeve->transform->translation.x(), 0.5357347770869189, 1e-9);
+  EXPECT_NEAR(sleeve->transform->translation.y(), 1.111086631392047, 1e-9);
+  EXPECT_NEAR(sleeve->transform->rotation_deg.z(), -50.48299999999997, 1e-9);
+  EXPECT_FALSE(sleeve->transform->pelvis_origin);
+  const auto skirt = read_garment(skirt_path);
+  EXPECT_EQ(skirt.fabric, "cotton");
+}
+
 TEST(Import, GarmentCodeLoopsKeepTheirWinding) {
   const auto path = DRAPE_REQUIRE_SHARED("patterns/garmentcode/shirt_mean_specification.json");
   const Garment g = garment_in_size(read_garment(path));

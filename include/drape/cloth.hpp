@@ -163,6 +163,12 @@ struct StepSettings {
   // which pull back springs that velocity modification alone leaves past the threshold (it only
   // stops further stretching), e.g. where seam forces or contacts pulled them.
   int position_passes = 0;
+  // With position modification (either kind): after the regular passes, further Gauss-Seidel passes
+  // over only the springs still at or near the limit (and the joined pairs), until none is over it
+  // by more than the tolerance or this many passes ran (0: none). A ring of springs (a waistband
+  // held by its hoop tension) gives up a widening only at ~(pi/n)^2 per pass for n springs round it,
+  // so holding it needs tens of passes, which would cost tens of full passes over the cloth.
+  int converge_passes = 0;
   // Viscous damping -gamma m v (1/s, sec. 2.2); negative: the fabric's air_damping. Quasi-static
   // draping raises it: the rest shape does not depend on it, only how fast the cloth gets there.
   float air_damping = -1.0f;
@@ -221,6 +227,7 @@ class StepScratch {
   std::vector<double> block_energy;       // per block: kinetic energy (fixed-order reduction)
   std::vector<float> block_speed;         // per block: max speed squared
   std::vector<uint32_t> block_count;      // per block: counters (contacts, corrections)
+  std::vector<uint32_t> active_spring;    // strain-limited springs near the limit (converge passes)
   size_t max_colliders = 0;
 };
 

@@ -35,7 +35,8 @@ void integrate_velocities(const StepContext& c);
 // strain_limit.cpp: velocity modification (sec. 3.3) and position modification (sec. 3.2).
 // answer_contacts: run respond_to_contacts after every pass (velocity collision response).
 StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contacts);
-StrainLimitResult limit_strain_position(const StepContext& c, int max_passes);
+// converge_passes: further passes over the springs still near the limit (StepSettings::converge_passes).
+StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, int converge_passes);
 
 // integrate.cpp: positions (eq. 3, last line) and the health check.
 void integrate_positions(const StepContext& c);

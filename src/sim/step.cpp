@@ -76,6 +76,7 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_energy.assign(blocks, 0.0);
   block_speed.assign(blocks, 0.0f);
   block_count.assign(blocks, 0u);
+  active_spring.assign(model.limit_a.size(), 0u);
   max_colliders = colliders;
 }
 
@@ -136,11 +137,11 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
   sim::integrate_positions(c);
   clock.mark(StepProfile::IntegratePositions);
   if (settings.strain_limit == StrainLimit::Position) {
-    limited = sim::limit_strain_position(c, settings.strain_passes);
+    limited = sim::limit_strain_position(c, settings.strain_passes, settings.converge_passes);
   } else if (settings.strain_limit == StrainLimit::Velocity && settings.position_passes > 0) {
     // Clean-up of what the velocity passes left (springs already past the threshold stay there
     // under velocity modification alone): counted with the velocity passes.
-    const sim::StrainLimitResult cleanup = sim::limit_strain_position(c, settings.position_passes);
+    const sim::StrainLimitResult cleanup = sim::limit_strain_position(c, settings.position_passes, settings.converge_passes);
     limited.passes += cleanup.passes;
     limited.corrections += cleanup.corrections;
     limited.at_pass_limit = limited.at_pass_limit || cleanup.at_pass_limit;

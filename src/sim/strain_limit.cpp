@@ -13,6 +13,9 @@
 // answering contacts only once, after the limit, lets each step's normal push stretch the springs
 // that leave the body at an angle (a table's edge) a little more. Passes stop early when a pass corrects nothing
 // beyond the tolerance (a strain change of 1e-4 of the rest length); the counts go to the profile.
+// Rings converge slowly under Gauss-Seidel (see the converge passes below): the position passes can
+// continue over only the springs still near the limit until none is over it
+// (StepSettings::converge_passes).
 #include "sim/kernels.hpp"
 #include "sim/parallel.hpp"
 #include "sim/stages.hpp"
@@ -69,16 +72,46 @@ StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contac
   });
 }
 
-StrainLimitResult limit_strain_position(const StepContext& c, int max_passes) {
+StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, int converge_passes) {
   const ClothModel& m = c.model;
   Vec3f* x = c.state.x.data();
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold;
-  return run_passes(c, max_passes, [&](size_t s) {
+  const auto limit = [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
     return limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest);
-  }, [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); }, [] {});
+  };
+  const auto hold = [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); };
+  StrainLimitResult result = run_passes(c, max_passes, limit, hold, [] {});
+  if (!result.at_pass_limit || converge_passes <= 0) return result;
+
+  // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, in index
+  // order on one thread (the same result on any number of threads). The set is gathered again every
+  // kRegather passes, since pulling one spring back stretches its neighbours. A ring needs tens of
+  // passes (its widening mode converges at ~(pi/n)^2 per pass), but it is a few hundred springs of
+  // thousands, so this costs a fraction of as many full passes.
+  constexpr float kNearLimit = 0.002f;  // strain below the threshold that still joins the set
+  constexpr int kRegather = 8;
+  uint32_t* active = c.scratch.active_spring.data();
+  size_t count = 0;
+  for (int pass = 0; pass < converge_passes; ++pass) {
+    if (pass % kRegather == 0) {
+      count = 0;
+      for (size_t s = 0; s < m.limit_a.size(); ++s) {
+        const float near = (stretch - kNearLimit) * m.limit_rest[s];
+        if ((x[m.limit_b[s]] - x[m.limit_a[s]]).squaredNorm() > near * near) active[count++] = static_cast<uint32_t>(s);
+      }
+    }
+    uint64_t corrections = 0;
+    for (size_t k = 0; k < count; ++k) corrections += limit(active[k]) ? 1u : 0u;
+    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
+    ++result.passes;
+    result.corrections += corrections;
+    result.at_pass_limit = corrections > 0;
+    if (corrections == 0) break;
+  }
+  return result;
 }
 
 }  // namespace drape::sim

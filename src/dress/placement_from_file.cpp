@@ -76,12 +76,14 @@ FileFrame file_frame(const Body& body, bool pelvis_origin) {
 
 // One panel as the file places it, in the body's frame.
 struct FilePanel {
-  Eigen::Matrix3d rotation;
-  Vec3d origin;         // T, heights mapped
-  Vec3d outward;        // the right side's normal
-  Vec3d up, across;     // in-plane unit axes of the rolled coordinates (across = up x outward)
-  Vec3d centre;         // centroid of the outline's vertices
-  double x_lo = 0, x_hi = 0, y_top = 0, y_bottom = 0;  // rolled coordinates' extent
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Vec3d origin = Vec3d::Zero();   // T, heights mapped
+  Vec3d outward = Vec3d::UnitZ(); // the right side's normal
+  // In-plane unit axes of the rolled coordinates (across = up x outward): up is the region's up
+  // direction (the body's for torso and legs, the arm's axis towards the shoulder for sleeves).
+  Vec3d up = Vec3d::UnitY(), across = Vec3d::UnitX();
+  Vec3d centre = Vec3d::Zero();   // centroid of the panel's mesh vertices
+  double x_lo = 0, x_hi = 0, y_top = 0;  // rolled coordinates' extent
   double world_x_lo = 0, world_x_hi = 0, world_y_lo = 0, world_y_hi = 0;
 };
 
@@ -93,13 +95,11 @@ FilePanel file_panel(const Panel& panel, const PanelMesh& mesh, const FileFrame&
   const double winding = panel.signed_area() >= 0 ? 1.0 : -1.0;
   f.outward = winding * f.rotation.col(2);
 
-  // The region's up direction in the file: the body's for torso and legs, the arm's axis (towards
-  // the shoulder) for a panel beyond the shoulders, decided by its centre.
+  // The centre of the panel's mesh, where the file puts it (decides the region).
   Vec3d centre = Vec3d::Zero();
   for (const Vec3f& q : mesh.mesh.positions) centre += f.rotation * Vec3d(q.x(), q.y(), 0);
   centre /= static_cast<double>(std::max<size_t>(1, mesh.mesh.positions.size()));
   f.centre = f.origin + centre;
-  f.up = Vec3d::UnitY();
   return f;
 }
 
@@ -110,7 +110,7 @@ void set_axes(FilePanel& f, const Vec3d& region_up, const PanelMesh& mesh, const
   if (up.norm() < 1e-3) up = f.rotation.col(1);  // a panel across the axis: its own y
   f.up = up.normalized();
   f.across = f.up.cross(n).normalized();
-  f.x_lo = f.y_bottom = std::numeric_limits<double>::max();
+  f.x_lo = std::numeric_limits<double>::max();
   f.x_hi = f.y_top = -f.x_lo;
   f.world_x_lo = f.world_y_lo = std::numeric_limits<double>::max();
   f.world_x_hi = f.world_y_hi = -f.world_x_lo;
@@ -118,7 +118,6 @@ void set_axes(FilePanel& f, const Vec3d& region_up, const PanelMesh& mesh, const
     const Vec3d d = f.rotation * Vec3d(q.x(), q.y(), 0);
     f.x_lo = std::min(f.x_lo, d.dot(f.across));
     f.x_hi = std::max(f.x_hi, d.dot(f.across));
-    f.y_bottom = std::min(f.y_bottom, d.dot(f.up));
     f.y_top = std::max(f.y_top, d.dot(f.up));
     const Vec3d p = f.origin + Vec3d(d.x(), frame.scale * d.y(), d.z());
     f.world_x_lo = std::min(f.world_x_lo, p.x());

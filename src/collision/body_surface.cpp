@@ -1,6 +1,7 @@
 // Body surface geometry for the collision layer; see body_surface.hpp.
 #include "collision/body_surface.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -86,6 +87,7 @@ void BodySurface::set_positions(std::span<const Vec3f> positions, double t) {
   }
   time_ = t;
   has_pose_ = true;
+  moving_ = std::any_of(velocities_.begin(), velocities_.end(), [](const Vec3f& v) { return v != Vec3f::Zero(); });
 
   // Face normals; smooth normals (area-weighted) and vertex pseudo-normals (angle-weighted, welded).
   smooth_normals_.assign(positions_.size(), Vec3f::Zero());
@@ -138,6 +140,31 @@ Vec3f BodySurface::pseudo_normal(const SurfaceHit& hit, bool& open) const {
     case TriangleFeature::kFace: break;
   }
   return face_normals_[hit.triangle];
+}
+
+void BodySurface::prefetch(const SurfaceHit& hit, int step) const {
+  const uint32_t t = hit.triangle;
+  const TriangleFeature feature = hit.where.feature;
+  const bool on_vertex = feature == TriangleFeature::kVertex0 || feature == TriangleFeature::kVertex1 || feature == TriangleFeature::kVertex2;
+  if (step == 0) {
+    __builtin_prefetch(&triangles_[t]);
+    if (feature == TriangleFeature::kFace) {
+      __builtin_prefetch(&face_normals_[t]);
+    } else if (!on_vertex) {
+      __builtin_prefetch(&edge_pseudo_normals_[t]);
+      __builtin_prefetch(&edge_neighbor_[t]);
+    }
+    return;
+  }
+  for (uint32_t v : triangles_[t]) {
+    __builtin_prefetch(&smooth_normals_[v]);
+    if (moving_) __builtin_prefetch(&velocities_[v]);
+  }
+  if (on_vertex) {
+    const uint32_t v = triangles_[t][static_cast<size_t>(feature)];  // kVertexK == K
+    __builtin_prefetch(&vertex_pseudo_normals_[v]);
+    __builtin_prefetch(&canonical_[v]);
+  }
 }
 
 float BodySurface::sign(const SurfaceHit& hit, const Vec3f& p) const {

@@ -55,6 +55,12 @@ class BodySurface {
   // Unit interpolated vertex normal at the hit (what a renderer's normal buffer holds).
   Vec3f smooth_normal(const SurfaceHit& hit) const;
   Vec3f velocity(const SurfaceHit& hit) const;
+  // False while every vertex velocity is zero (a static body): velocity() is then zero everywhere.
+  bool moving() const { return moving_; }
+
+  // Prefetch what sign(), smooth_normal() and velocity() will read for `hit`, in two steps for a
+  // batch of hits (step 0: the triangle's own entries; step 1: its vertices', which needs step 0's).
+  void prefetch(const SurfaceHit& hit, int step) const;
 
  private:
   Vec3f pseudo_normal(const SurfaceHit& hit, bool& open) const;
@@ -69,6 +75,7 @@ class BodySurface {
   bool closed_ = true;
   double time_ = 0;
   bool has_pose_ = false;
+  bool moving_ = false;
   WindingNumberTree winding_;  // built only for open meshes
 };
 

@@ -1,31 +1,36 @@
 // Object-space body collider; see bvh_collider.hpp.
 #include "collision/bvh_collider.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 
 namespace drape::collision {
 
-bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactSample& out) {
-  SurfaceHit hit;
-  if (!bvh.closest(p, radius, hit)) {
+void sample_from_hit(const BodySurface& surface, const SurfaceHit* hit, const Vec3f& p, ContactSample& out) {
+  if (!hit) {
     out.distance = std::numeric_limits<float>::infinity();
     out.normal = Vec3f::Zero();
     out.velocity = Vec3f::Zero();
-    return false;
+    return;
   }
-  const BodySurface& surface = bvh.surface();
-  const float sign = surface.sign(hit, p);
-  out.distance = sign * hit.distance;
-  out.normal = surface.smooth_normal(hit);
+  const float sign = surface.sign(*hit, p);
+  out.distance = sign * hit->distance;
+  out.normal = surface.smooth_normal(*hit);
   // Away from the surface, the way out is along p - nearest point; the interpolated normal can point
   // elsewhere at a crease (the top of a narrow gap), which would push the cloth into the other wall.
-  if (hit.distance > 1e-3f) {
-    const Vec3f out_direction = sign * (p - hit.where.point) / hit.distance;
+  if (hit->distance > 1e-3f) {
+    const Vec3f out_direction = sign * (p - hit->where.point) / hit->distance;
     if (out_direction.dot(out.normal) < 0.7f) out.normal = out_direction;
   }
-  out.velocity = surface.velocity(hit);
-  return true;
+  out.velocity = surface.moving() ? surface.velocity(*hit) : Vec3f::Zero();
+}
+
+bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactSample& out) {
+  SurfaceHit hit;
+  const bool found = bvh.closest(p, radius, hit);
+  sample_from_hit(bvh.surface(), found ? &hit : nullptr, p, out);
+  return found;
 }
 
 BvhCollider::BvhCollider(const Mesh& body) : surface_(body.positions, body.triangles) {
@@ -46,7 +51,19 @@ void BvhCollider::set_surface(std::span<const Vec3f> positions, double t) {
 }
 
 void BvhCollider::query(std::span<const Vec3f> points, float radius, std::span<ContactSample> out) const {
-  for (size_t i = 0; i < points.size(); ++i) exact_sample(*bvh_, points[i], radius, out[i]);
+  // In chunks: the nearest points of the whole chunk (batched: TriangleBvh::closest_batch), then
+  // the surface data of all their triangles prefetched in two rounds, then the samples.
+  constexpr size_t kChunk = 64;
+  SurfaceHit hits[kChunk];
+  uint8_t found[kChunk];
+  for (size_t start = 0; start < points.size(); start += kChunk) {
+    const size_t n = std::min(kChunk, points.size() - start);
+    bvh_->closest_batch(points.subspan(start, n), radius, std::span(hits, n), std::span(found, n));
+    for (int step = 0; step < 2; ++step)
+      for (size_t j = 0; j < n; ++j)
+        if (found[j]) surface_.prefetch(hits[j], step);
+    for (size_t j = 0; j < n; ++j) sample_from_hit(surface_, found[j] ? &hits[j] : nullptr, points[start + j], out[start + j]);
+  }
 }
 
 }  // namespace drape::collision

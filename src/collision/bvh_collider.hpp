@@ -13,6 +13,8 @@ namespace drape::collision {
 // One exact signed sample at p: the answer of the BVH method, shared by the others' fallbacks.
 // False when the body is farther than radius.
 bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactSample& out);
+// The sample at p whose nearest body point is `hit` (nullptr: nothing within the radius).
+void sample_from_hit(const BodySurface& surface, const SurfaceHit* hit, const Vec3f& p, ContactSample& out);
 
 class BvhCollider final : public BodyCollider {
  public:

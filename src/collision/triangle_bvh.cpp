@@ -104,18 +104,46 @@ void TriangleBvh::build_candidate_grid(float cell, float band) {
   grid_ = std::make_unique<CandidateGrid>(*this, cell, band);
 }
 
-bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
-  if (grid_) {
-    using Answer = CandidateGrid::Answer;
-    const Answer answer = grid_->closest(p, radius, hit);
-    if (answer == Answer::kFound || answer == Answer::kNone) return answer == Answer::kFound;
-    if (answer == Answer::kTruncatedFound) {  // the tree looks only for something nearer than the best so far
-      SurfaceHit nearer;
-      if (closest_in_tree(p, hit.distance, nearer)) hit = nearer;
-      return true;
-    }
+bool TriangleBvh::finish(CandidateGrid::Answer answer, const Vec3f& p, float radius, SurfaceHit& hit) const {
+  using Answer = CandidateGrid::Answer;
+  if (answer == Answer::kFound || answer == Answer::kNone) return answer == Answer::kFound;
+  if (answer == Answer::kTruncatedFound) {  // the tree looks only for something nearer than the best so far
+    SurfaceHit nearer;
+    if (closest_in_tree(p, hit.distance, nearer)) hit = nearer;
+    return true;
   }
   return closest_in_tree(p, radius, hit);
+}
+
+bool TriangleBvh::closest(const Vec3f& p, float radius, SurfaceHit& hit) const {
+  if (grid_) return finish(grid_->closest(p, radius, hit), p, radius, hit);
+  return closest_in_tree(p, radius, hit);
+}
+
+void TriangleBvh::closest_batch(std::span<const Vec3f> points, float radius, std::span<SurfaceHit> hits,
+                                std::span<uint8_t> found) const {
+  if (!grid_) {
+    for (size_t i = 0; i < points.size(); ++i) found[i] = closest_in_tree(points[i], radius, hits[i]);
+    return;
+  }
+  // Per chunk: every point's cell, then three rounds of prefetches (offsets, lists, triangles),
+  // each issued for the whole chunk before the next round reads what the previous one fetched.
+  constexpr size_t kChunk = 32;
+  size_t cells[kChunk];
+  for (size_t start = 0; start < points.size(); start += kChunk) {
+    const size_t n = std::min(kChunk, points.size() - start);
+    const Vec3f* p = points.data() + start;
+    for (size_t j = 0; j < n; ++j) {
+      cells[j] = grid_->cell_of(p[j]);
+      grid_->prefetch_offsets(cells[j]);
+    }
+    for (size_t j = 0; j < n; ++j) grid_->prefetch_list(cells[j]);
+    for (size_t j = 0; j < n; ++j) grid_->prefetch_triangles(cells[j]);
+    for (size_t j = 0; j < n; ++j) {
+      SurfaceHit& hit = hits[start + j];
+      found[start + j] = finish(grid_->closest_in(cells[j], p[j], radius, hit), p[j], radius, hit);
+    }
+  }
 }
 
 void TriangleBvh::within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const {

@@ -13,6 +13,7 @@
 #include <embree3/rtcore.h>
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "collision/body_surface.hpp"
@@ -33,11 +34,14 @@ class TriangleBvh {
   void update();
 
   // Builds the candidate grid for the current pose (cells of `cell` metres within `band` of the surface).
-  void build_candidate_grid(float cell = 0.008f, float band = 0.012f);
+  void build_candidate_grid(float cell = 0.008f, float band = 0.016f);
   const CandidateGrid* candidate_grid() const { return grid_.get(); }
 
   // Nearest point of the body to p within `radius`; false when there is none. Thread-safe.
   bool closest(const Vec3f& p, float radius, SurfaceHit& hit) const;
+  // closest() for a batch of points: found[i] and hits[i] as closest(points[i], ...) gives them,
+  // faster, since the candidate grid's cache misses of many points overlap (CandidateGrid::cell_of).
+  void closest_batch(std::span<const Vec3f> points, float radius, std::span<SurfaceHit> hits, std::span<uint8_t> found) const;
   // Nearest point through the tree only (no candidate grid).
   bool closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const;
   // Every triangle within `radius` of p (cleared first), in the tree's order.
@@ -47,6 +51,8 @@ class TriangleBvh {
 
  private:
   void upload_vertices();
+  // Completes the candidate grid's answer for p (asks the tree where the grid cannot tell).
+  bool finish(CandidateGrid::Answer answer, const Vec3f& p, float radius, SurfaceHit& hit) const;
 
   const BodySurface& surface_;
   RTCDevice device_ = nullptr;

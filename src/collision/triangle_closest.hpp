@@ -16,7 +16,7 @@ struct TrianglePoint {
   TriangleFeature feature;
 };
 
-inline TrianglePoint closest_on_triangle(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+[[gnu::always_inline]] inline TrianglePoint closest_on_triangle(const Vec3f& p, const Vec3f& a, const Vec3f& b, const Vec3f& c) {
   const Vec3f ab = b - a, ac = c - a, ap = p - a;
   const float d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0.0f && d2 <= 0.0f) return {a, 0.0f, 0.0f, TriangleFeature::kVertex0};

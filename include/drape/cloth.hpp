@@ -167,7 +167,9 @@ struct StepSettings {
   // over only the springs still at or near the limit (and the joined pairs), until none is over it
   // by more than the tolerance or this many passes ran (0: none). A ring of springs (a waistband
   // held by its hoop tension) gives up a widening only at ~(pi/n)^2 per pass for n springs round it,
-  // so holding it needs tens of passes, which would cost tens of full passes over the cloth.
+  // so holding it needs tens of passes, which would cost tens of full passes over the cloth. These
+  // corrections also change the velocities by the displacement over the step (dx / dt), so use them
+  // where corrections are small (draping), not where seams pull panels far past the limit.
   int converge_passes = 0;
   // Viscous damping -gamma m v (1/s, sec. 2.2); negative: the fabric's air_damping. Quasi-static
   // draping raises it: the rest shape does not depend on it, only how fast the cloth gets there.

@@ -24,7 +24,7 @@
 namespace drape {
 namespace {
 
-constexpr int kConvergePasses = 64;  // StepSettings::converge_passes while draping
+constexpr int kConvergePasses = 128;  // StepSettings::converge_passes while draping
 
 // Velocity modification of one zero-length seam spring: no opening, no overshoot.
 inline void limit_seam_velocity(const Vec3f& xa, const Vec3f& xb, Vec3f& va, Vec3f& vb, float wa, float wb, float dt) {

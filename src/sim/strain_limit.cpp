@@ -91,9 +91,16 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   // kRegather passes, since pulling one spring back stretches its neighbours. A ring needs tens of
   // passes (its widening mode converges at ~(pi/n)^2 per pass), but it is a few hundred springs of
   // thousands, so this costs a fraction of as many full passes.
+  // Their corrections also go into the velocities (v += dx / dt, as position-based dynamics does):
+  // otherwise the particles keep the velocity that over-stretched the ring, which velocity
+  // modification takes out of a ring only slowly, and move straight back out next step; the band
+  // trembles and the garment does not settle (skirt and trousers S/M/L: 2 of 6 settled without,
+  // 5 of 6 with, docs/dressing.md).
   constexpr float kNearLimit = 0.002f;  // strain below the threshold that still joins the set
   constexpr int kRegather = 8;
   uint32_t* active = c.scratch.active_spring.data();
+  Vec3f* v = c.state.v.data();
+  const float inv_dt = 1.0f / c.dt;
   size_t count = 0;
   for (int pass = 0; pass < converge_passes; ++pass) {
     if (pass % kRegather == 0) {
@@ -104,7 +111,13 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
       }
     }
     uint64_t corrections = 0;
-    for (size_t k = 0; k < count; ++k) corrections += limit(active[k]) ? 1u : 0u;
+    for (size_t k = 0; k < count; ++k) {
+      const uint32_t a = m.limit_a[active[k]], b = m.limit_b[active[k]];
+      const Vec3f xa = x[a], xb = x[b];
+      corrections += limit(active[k]) ? 1u : 0u;
+      v[a] += (x[a] - xa) * inv_dt;
+      v[b] += (x[b] - xb) * inv_dt;
+    }
     for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
     ++result.passes;
     result.corrections += corrections;

@@ -274,15 +274,16 @@ INSTANTIATE_TEST_SUITE_P(GarmentCode, ImportedPattern,
                                            "garmentcode/hoody_mean_specification.json"),
                          pattern_case_name);
 
-// NOT YET REACHED (DISABLED_ prefix, as above), measured at 16:50 UTC on mean_all with the
+// NOT YET REACHED (DISABLED_ prefix, as above), measured at 17:15 UTC on mean_all with the
 // placement from the file (docs/garment-format.md, Dressing an import): no explosion, but
-//   dress_pencil (flat, jersey): every seam closed, but the dress slides down the body and off
-//     (drop 0.78 m), strain 13 %;
-//   flare_skirt (flat, jersey): every seam closed, the waistband slides down the hips and off;
-//   tee (2021, rolled, cotton): side seams 80 mm open: 0.87 m round the chest on a 1.01 m bust
-//     (sized for the SMPL female body);
-//   skirt_4_panels (2021): tilted side panels, seams 19-28 mm open, 10 vertices inside, unsettled;
-//   pants_straight_sides (2021): crotch and inseams 41-134 mm open (SMPL-sized hips on mean_all).
+//   dress_pencil (flat, jersey): every seam closed, strain 10.1 %, but the dress slides down the
+//     body and off (drop 0.69 m, below the floor), not settled;
+//   flare_skirt (flat, jersey): every seam closed, strain 10.6 %, the waistband (0.84 m round, as
+//     the body's waist) slides down the hips: drop 0.154 m (limit 0.15), not settled after 3 s;
+//   tee (2021, rolled, cotton): side and shoulder seams 63-82 mm open: 0.87 m round the chest on
+//     a 1.01 m bust (sized for the SMPL female body);
+//   skirt_4_panels (2021): seams 15-22 mm open (mean_all's waist 0.84 m);
+//   pants_straight_sides (2021): crotch and side seams 38-138 mm open, not settled.
 INSTANTIATE_TEST_SUITE_P(DISABLED_GarmentCode, ImportedPattern,
                          ::testing::Values("garmentcode/dress_pencil_specification.json",
                                            "garmentcode/flare_skirt_specification.json",

@@ -119,8 +119,9 @@ BENCHMARK_CAPTURE(BM_Query, image_plain_on_vertices, CollisionMethod::image, fal
 BENCHMARK_CAPTURE(BM_Query, bvh_on_vertices, CollisionMethod::bvh, true, true)->Arg(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // The closest-point search alone: Embree's rtcPointQuery, the same with the candidate grid in front
-// (what the bvh method uses for a static body), and the hand-made box BVH; same points, same radius.
-template <class Bvh, bool kGrid = false>
+// one point at a time and batched (what the bvh method uses for a static body), and the hand-made
+// box BVH; same points, same radius.
+template <class Bvh, bool kGrid = false, bool kBatch = false>
 void BM_ClosestPoint(benchmark::State& state) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
   const collision::BodySurface surface(body()->positions, body()->triangles);
@@ -132,15 +133,23 @@ void BM_ClosestPoint(benchmark::State& state) {
     bvh = std::make_unique<Bvh>(surface);
   }
   const auto& points = cloth_points();
+  std::vector<collision::SurfaceHit> hits(points.size());
+  std::vector<uint8_t> found(points.size());
   for (auto _ : state) {
-    collision::SurfaceHit hit;
-    for (const Vec3f& p : points) benchmark::DoNotOptimize(bvh->closest(p, kQueryRadius, hit));
+    if constexpr (kBatch) {
+      bvh->closest_batch(points, kQueryRadius, hits, found);
+      benchmark::DoNotOptimize(found.data());
+    } else {
+      collision::SurfaceHit hit;
+      for (const Vec3f& p : points) benchmark::DoNotOptimize(bvh->closest(p, kQueryRadius, hit));
+    }
   }
   state.counters["ns_per_vertex"] = benchmark::Counter(static_cast<double>(state.iterations() * points.size()),
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::TriangleBvh)->Name("BM_ClosestPoint/embree")->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::TriangleBvh, true)->Name("BM_ClosestPoint/embree_grid")->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::TriangleBvh, true, true)->Name("BM_ClosestPoint/embree_grid_batch")->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(BM_ClosestPoint, collision::BoxBvh)->Name("BM_ClosestPoint/box_bvh")->Unit(benchmark::kMillisecond);
 
 // Per frame of a moving body: new vertex positions, then maps re-rendered / BVH refitted / field

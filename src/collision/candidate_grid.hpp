@@ -6,15 +6,17 @@
 //
 // Why a list per cell and not only a tree: a tree query must descend from the root, and near a
 // curved surface the boxes of many leaves overlap the query sphere (Embree's rtcPointQuery measured
-// about 0.9 us per cloth vertex on a 47.5k-triangle body, the hand-made box BVH 1.4 us). A cell's
-// list answers with a handful of point-triangle tests.
+// about 580 ns per cloth vertex on the 47.5k-triangle mean body, the hand-made box BVH 1.1 us). A
+// cell's list answers with about 3 point-triangle tests.
 //
-// Correctness: for a point p in a cell with centre c and half diagonal r, and d_c the distance
-// from c to the body, the nearest triangle T* of p satisfies d(c, T*) <= d(p, T*) + r <= d_c + 2r;
-// the list keeps every triangle with d(c, T) <= d_c + 2r, so it always holds T*. Scanning the list
-// in order of d(c, T) stops once d(c, T) - |p - c| reaches the best distance so far (no later
-// triangle can be nearer). Cells beyond the band store no list: a point there is at least
-// band - r from the body.
+// Correctness: for a point p in a cell with centre c and half diagonal r, U (the largest distance
+// from a corner of the cell to the centre's nearest triangle) bounds d(p, body) from above. A
+// triangle T, with q its point nearest c and u = (c - q) / |c - q|, lies behind the plane through q
+// across u (T is convex), so d(p, T) >= d(c, T) + (p - c) . u >= d(c, T) - h(u), h(u) the cell's
+// half extent along u. The list keeps every T with d(c, T) - h(u) <= U: the nearest triangle of
+// any p of the cell is among them. A scan in order of d(c, T) skips T when d(c, T) + (p - c) . u
+// reaches the best distance so far and stops once d(c, T) - |p - c| does (no later one can be
+// nearer). Cells beyond the band store no list: a point there is at least band - r from the body.
 #include <cstdint>
 #include <vector>
 

@@ -1,15 +1,14 @@
 #pragma once
 // Object-space closest-point queries on the body triangles (Vassilev & Spanlang sec. 4.1) through
 // Embree 3's bounding volume hierarchy and rtcPointQuery. The paper built a quad tree of bounding
-// boxes per scanned body part; Embree's BVH does the same job for any triangle mesh and refits in
-// place when the body moves (RTC_BUILD_QUALITY_REFIT). A hand-made binary BVH (box_bvh.hpp)
-// measured about 1.7x slower per query on this machine (bench_collision), so the colliders use this. The paper built a quad tree of bounding
 // boxes per scanned body part; Embree's SAH BVH does the same job for any triangle mesh and refits
-// in place when the body moves (RTC_BUILD_QUALITY_REFIT), which is what an animated body needs.
+// in place when the body moves (RTC_BUILD_QUALITY_REFIT), which is what an animated body needs. A
+// hand-made binary BVH (box_bvh.hpp) measured about 1.8x slower per query (bench_collision).
 //
 // Near a static body, queries go first to a CandidateGrid (candidate_grid.hpp): per-cell lists of
-// the triangles that can be nearest, several times faster than the tree descent. A moving body's
-// update() drops the grid (its lists hold for the pose they were built for) and the tree answers.
+// the triangles that can be nearest, about 3x faster than the tree descent (batched). A moving
+// body's update() drops the grid (its lists hold for the pose they were built for) and the tree
+// answers.
 #include <embree3/rtcore.h>
 
 #include <memory>

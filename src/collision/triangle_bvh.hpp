@@ -33,7 +33,7 @@ class TriangleBvh {
   void update();
 
   // Builds the candidate grid for the current pose (cells of `cell` metres within `band` of the surface).
-  void build_candidate_grid(float cell = 0.008f, float band = 0.016f);
+  void build_candidate_grid(float cell = 0.007f, float band = 0.016f);
   const CandidateGrid* candidate_grid() const { return grid_.get(); }
 
   // Nearest point of the body to p within `radius`; false when there is none. Thread-safe.

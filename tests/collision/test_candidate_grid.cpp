@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <random>
+#include <vector>
 
 #include "collision/triangle_bvh.hpp"
 #include "drape/io.hpp"
@@ -26,9 +27,11 @@ TEST(CandidateGrid, AnswersExactlyAsTheTree) {
   std::uniform_real_distribution<float> offset(-0.04f, 0.04f), jitter(-0.005f, 0.005f);
   const int count = std::getenv("DRAPE_SANITIZED") ? 2000 : 20000;
   int found = 0;
+  std::vector<Vec3f> points;
   for (int i = 0; i < count; ++i) {
     const size_t v = vertex(rng);
     const Vec3f p = body.positions[v] + offset(rng) * normals[v] + Vec3f(jitter(rng), jitter(rng), jitter(rng));
+    points.push_back(p);
     for (float radius : {0.005f, 0.02f, 0.1f}) {
       SurfaceHit grid_hit, tree_hit;
       const bool in_grid = bvh.closest(p, radius, grid_hit);
@@ -41,6 +44,20 @@ TEST(CandidateGrid, AnswersExactlyAsTheTree) {
     }
   }
   EXPECT_GT(found, count);  // most points have the body within the larger radii
+  // The batched query (staged prefetches over chunks of points) gives the same answers.
+  for (float radius : {0.005f, 0.02f, 0.1f}) {
+    std::vector<SurfaceHit> hits(points.size());
+    std::vector<uint8_t> in_batch(points.size());
+    bvh.closest_batch(points, radius, hits, in_batch);
+    for (size_t i = 0; i < points.size(); ++i) {
+      SurfaceHit single;
+      const bool in_single = bvh.closest(points[i], radius, single);
+      ASSERT_EQ(in_batch[i] != 0, in_single) << "point " << points[i].transpose() << " radius " << radius;
+      if (in_single) {
+        ASSERT_EQ(hits[i].distance, single.distance) << "point " << points[i].transpose();
+      }
+    }
+  }
   // A moving body's update drops the grid (its lists hold for the old pose only).
   bvh.update();
   EXPECT_EQ(bvh.candidate_grid(), nullptr);

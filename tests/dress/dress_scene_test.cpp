@@ -95,32 +95,37 @@ TEST_P(BuiltinFit, PassesTheGates) {
   expect_dressed(cached_body(GetParam().sex), GetParam().garment, GetParam().size);
 }
 INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
-                         ::testing::Values(Fit{"dress", "L", Sex::Female}, Fit{"dress", "XL", Sex::Male}),
+                         ::testing::Values(Fit{"shirt", "XL", Sex::Male}, Fit{"dress", "L", Sex::Female}, Fit{"dress", "XL", Sex::Male},
+                                           Fit{"skirt", "M", Sex::Female}, Fit{"skirt", "L", Sex::Female},
+                                           Fit{"trousers", "M", Sex::Female}, Fit{"trousers", "L", Sex::Female}),
                          fit_name);
 
 // NOT YET REACHED (measured failures, see docs/dressing.md "Status"):
-// - shirt XL (men's cut) on the male body: seams closed, strain 7.0 % (limit 6 %) at the back
-//   armholes and the pinched sleeve underarm; S/M/L on the male body: a shoulder/armhole corner
-//   10-20 mm open (the female-graded shoulders end on his acromions);
+// - shirt S/M/L on the male body (XL is his cut): a shoulder/armhole corner 10-20 mm open (the
+//   female-graded shoulders end on his acromions);
 // - dress S and M on the female body: marginal, they pass or not with small changes elsewhere
 //   (S: a shoulder seam 12 mm open; M: seams closed, 3.0 %, but still moving at 3 cm/s after 3 s);
 //   dress S/M/L on the male body (XL is his cut): shoulder seams 26-30 mm open at his wider neck;
 // - jeans: an outseam stays 34-42 mm open at the hip (inseams closed, strain 2.1-2.3 %, limit 3 %);
-// - skirt and trousers: the band creeps down the hips (not settled) or the hips stretch past
-//   wool's limit, a strain-limit convergence problem (docs/dressing.md); skirt S/M (waists
-//   0.78/0.82 m) are smaller than the male waist (0.86 m): L is his size.
+// - skirt and trousers S on the female body: strain at the limit (5.0 %) since the strain limit's
+//   converge passes (docs/cloth.md), every seam closed, but marginal on settling (here still
+//   moving after 3 s; settled in `drape dress --garment skirt|trousers --size S`); M and L pass;
+//   on the male body not measured since; skirt S/M (waists 0.78/0.82 m) are smaller than the male
+//   waist (0.86 m): L is his size.
 class BuiltinNotYet : public BuiltinFit {};
 TEST_P(BuiltinNotYet, DISABLED_PassesTheGates) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   expect_dressed(cached_body(GetParam().sex), GetParam().garment, GetParam().size);
 }
 std::vector<Fit> not_yet() {
-  std::vector<Fit> fits = {{"shirt", "XL", Sex::Male}, {"dress", "S", Sex::Female}, {"dress", "M", Sex::Female}};
+  std::vector<Fit> fits = {{"dress", "S", Sex::Female}, {"dress", "M", Sex::Female}};
   for (const char* size : {"S", "M", "L"}) {
     fits.push_back({"shirt", size, Sex::Male});
     fits.push_back({"dress", size, Sex::Male});
     for (const char* garment : {"skirt", "trousers", "jeans"})
-      for (Sex sex : {Sex::Female, Sex::Male}) fits.push_back({garment, size, sex});
+      for (Sex sex : {Sex::Female, Sex::Male})
+        if (std::string(garment) == "jeans" || sex == Sex::Male || std::string(size) == "S")
+          fits.push_back({garment, size, sex});
   }
   return fits;
 }

@@ -143,9 +143,16 @@ TEST_P(SharedBody, DefaultShirt) {
   expect_dressed(load_body(path), default_garment_name(), "");
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBody,
-                         ::testing::Values("bodies/garmentcode/mean_all.obj", "bodies/makehuman/derived/mh_female_average.obj",
-                                           "bodies/makehuman/derived/mh_female_heavy.obj"),
+                         ::testing::Values("bodies/garmentcode/mean_all.obj", "bodies/makehuman/derived/mh_female_average.obj"),
                          body_stem);
+
+// The heavy female body (upper arm 0.30 m) wears the shirt's L: in M a sleeve's armhole corner
+// stays 35 mm open round her arm.
+TEST(DressScene, ShirtLOnHeavyFemaleBody) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const auto path = DRAPE_REQUIRE_SHARED("bodies/makehuman/derived/mh_female_heavy.obj");
+  expect_dressed(load_body(path), default_garment_name(), "L");
+}
 
 // The male MakeHuman bodies wear the shirt's men's cut, XL (their shoulders and armpits are too
 // wide and low for the female-graded S/M/L: a shoulder/armhole corner stays 8-9 cm open).

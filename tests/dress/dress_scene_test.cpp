@@ -97,7 +97,8 @@ TEST_P(BuiltinFit, PassesTheGates) {
 INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
                          ::testing::Values(Fit{"shirt", "XL", Sex::Male}, Fit{"dress", "L", Sex::Female}, Fit{"dress", "XL", Sex::Male},
                                            Fit{"skirt", "M", Sex::Female}, Fit{"skirt", "L", Sex::Female},
-                                           Fit{"trousers", "M", Sex::Female}, Fit{"trousers", "L", Sex::Female}),
+                                           Fit{"trousers", "M", Sex::Female}, Fit{"trousers", "L", Sex::Female},
+                                           Fit{"jeans", "M", Sex::Female}, Fit{"jeans", "L", Sex::Female}),
                          fit_name);
 
 // NOT YET REACHED (measured failures, see docs/dressing.md "Status"):
@@ -106,7 +107,8 @@ INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
 // - dress S and M on the female body: marginal, they pass or not with small changes elsewhere
 //   (S: a shoulder seam 12 mm open; M: seams closed, 3.0 %, but still moving at 3 cm/s after 3 s);
 //   dress S/M/L on the male body (XL is his cut): shoulder seams 26-30 mm open at his wider neck;
-// - jeans: an outseam stays 34-42 mm open at the hip (inseams closed, strain 2.1-2.3 %, limit 3 %);
+// - jeans S on the female body and M/L on the male body: an outseam's top corner stays 7-36 mm
+//   open at the hip (inseams closed, strain 2.0 %, limit 3 %); a wider band slides off;
 // - skirt and trousers S on the female body: strain at the limit (5.0 %) since the strain limit's
 //   converge passes (docs/cloth.md), every seam closed, but marginal on settling (here still
 //   moving after 3 s; settled in `drape dress --garment skirt|trousers --size S`); M and L pass;
@@ -124,7 +126,7 @@ std::vector<Fit> not_yet() {
     fits.push_back({"dress", size, Sex::Male});
     for (const char* garment : {"skirt", "trousers", "jeans"})
       for (Sex sex : {Sex::Female, Sex::Male})
-        if (std::string(garment) == "jeans" || sex == Sex::Male || std::string(size) == "S")
+        if (sex == Sex::Male || std::string(size) == "S")
           fits.push_back({garment, size, sex});
   }
   return fits;

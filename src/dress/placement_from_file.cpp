@@ -83,8 +83,15 @@ struct FilePanel {
   // direction (the body's for torso and legs, the arm's axis towards the shoulder for sleeves).
   Vec3d up = Vec3d::UnitY(), across = Vec3d::UnitX();
   Vec3d centre = Vec3d::Zero();   // centroid of the panel's mesh vertices
+  double scale = 1;               // the frame's height scale
   double x_lo = 0, x_hi = 0, y_top = 0;  // rolled coordinates' extent
   double world_x_lo = 0, world_x_hi = 0, world_y_lo = 0, world_y_hi = 0;
+
+  // A panel-mesh point where the file puts it, heights mapped onto the body.
+  Vec3d world(const Vec3f& q) const {
+    const Vec3d d = rotation * Vec3d(q.x(), q.y(), 0);
+    return origin + Vec3d(d.x(), scale * d.y(), d.z());
+  }
 };
 
 FilePanel file_panel(const Panel& panel, const PanelMesh& mesh, const FileFrame& frame) {
@@ -92,6 +99,7 @@ FilePanel file_panel(const Panel& panel, const PanelMesh& mesh, const FileFrame&
   FilePanel f;
   f.rotation = rotation_of(t);
   f.origin = Vec3d(t.translation.x(), frame.height(t.translation.y()), t.translation.z());
+  f.scale = frame.scale;
   const double winding = panel.signed_area() >= 0 ? 1.0 : -1.0;
   f.outward = winding * f.rotation.col(2);
 
@@ -100,11 +108,21 @@ FilePanel file_panel(const Panel& panel, const PanelMesh& mesh, const FileFrame&
   for (const Vec3f& q : mesh.mesh.positions) centre += f.rotation * Vec3d(q.x(), q.y(), 0);
   centre /= static_cast<double>(std::max<size_t>(1, mesh.mesh.positions.size()));
   f.centre = f.origin + centre;
+
+  f.world_x_lo = f.world_y_lo = std::numeric_limits<double>::max();
+  f.world_x_hi = f.world_y_hi = -f.world_x_lo;
+  for (const Vec3f& q : mesh.mesh.positions) {
+    const Vec3d p = f.world(q);
+    f.world_x_lo = std::min(f.world_x_lo, p.x());
+    f.world_x_hi = std::max(f.world_x_hi, p.x());
+    f.world_y_lo = std::min(f.world_y_lo, p.y());
+    f.world_y_hi = std::max(f.world_y_hi, p.y());
+  }
   return f;
 }
 
 // In-plane axes once the region's up direction is known: up projected into the panel's plane.
-void set_axes(FilePanel& f, const Vec3d& region_up, const PanelMesh& mesh, const FileFrame& frame) {
+void set_axes(FilePanel& f, const Vec3d& region_up, const PanelMesh& mesh) {
   const Vec3d n = f.outward;
   Vec3d up = region_up - region_up.dot(n) * n;
   if (up.norm() < 1e-3) up = f.rotation.col(1);  // a panel across the axis: its own y
@@ -112,18 +130,11 @@ void set_axes(FilePanel& f, const Vec3d& region_up, const PanelMesh& mesh, const
   f.across = f.up.cross(n).normalized();
   f.x_lo = std::numeric_limits<double>::max();
   f.x_hi = f.y_top = -f.x_lo;
-  f.world_x_lo = f.world_y_lo = std::numeric_limits<double>::max();
-  f.world_x_hi = f.world_y_hi = -f.world_x_lo;
   for (const Vec3f& q : mesh.mesh.positions) {
     const Vec3d d = f.rotation * Vec3d(q.x(), q.y(), 0);
     f.x_lo = std::min(f.x_lo, d.dot(f.across));
     f.x_hi = std::max(f.x_hi, d.dot(f.across));
     f.y_top = std::max(f.y_top, d.dot(f.up));
-    const Vec3d p = f.origin + Vec3d(d.x(), frame.scale * d.y(), d.z());
-    f.world_x_lo = std::min(f.world_x_lo, p.x());
-    f.world_x_hi = std::max(f.world_x_hi, p.x());
-    f.world_y_lo = std::min(f.world_y_lo, p.y());
-    f.world_y_hi = std::max(f.world_y_hi, p.y());
   }
 }
 
@@ -149,20 +160,22 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
   // A copy of the garment with hints derived from the file, and its meshes in rolled coordinates.
   bool any_arm = false;
   std::vector<double> rise(garment.panels.size(), 0.0);  // body height per unit of rolled y
+  std::vector<FilePanel> files;
+  files.reserve(garment.panels.size());
   Garment rolled = garment;
   GarmentMesh rolled_mesh = mesh;
   for (size_t p = 0; p < garment.panels.size(); ++p) {
     const Panel& panel = garment.panels[p];
-    FilePanel f = file_panel(panel, mesh.panels[p], frame);
+    FilePanel& f = files.emplace_back(file_panel(panel, mesh.panels[p], frame));
 
     // Region, by where the file puts the panel.
     BodyRegion region = BodyRegion::torso;
-    set_axes(f, Vec3d::UnitY(), mesh.panels[p], frame);
+    set_axes(f, Vec3d::UnitY(), mesh.panels[p]);
     if (std::abs(f.centre.x()) > shoulder_x && f.centre.y() > 0.5 * (l.waist.y() + l.crotch.y())) {
       region = f.centre.x() > 0 ? BodyRegion::left_arm : BodyRegion::right_arm;
       const double a = frame.arm_angle_deg * kDegToRad;
       const Vec3d arm_up(region == BodyRegion::left_arm ? -std::cos(a) : std::cos(a), std::sin(a), 0.0);
-      set_axes(f, arm_up, mesh.panels[p], frame);
+      set_axes(f, arm_up, mesh.panels[p]);
     } else if (f.world_y_lo < l.crotch.y() && (f.world_x_lo > -kMidlineSlack || f.world_x_hi < kMidlineSlack)) {
       region = f.world_x_lo > -kMidlineSlack ? BodyRegion::left_leg : BodyRegion::right_leg;
     }
@@ -222,17 +235,12 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
     std::vector<ContactSample> contact;
     bool clear = true;
     for (size_t p = 0; p < garment.panels.size() && clear; ++p) {
-      const Panel& panel = garment.panels[p];
-      const Eigen::Matrix3d r = rotation_of(*panel.transform);
       auto& x = out.positions[p];
-      for (const Vec3f& q : mesh.panels[p].mesh.positions) {
-        const Vec3d d = r * Vec3d(q.x(), q.y(), 0) + panel.transform->translation;
-        x.push_back(to_f(Vec3d(d.x(), frame.height(d.y()), d.z())));
-      }
+      for (const Vec3f& q : mesh.panels[p].mesh.positions) x.push_back(to_f(files[p].world(q)));
       contact.resize(x.size());
       body_collider.query(x, kFlatClearance, contact);
       for (const ContactSample& c : contact) clear = clear && c.distance >= kFlatClearance;
-      out.info[p] = {panel.name, "transform: flat, as in the file", kFlatClearance, 0};
+      out.info[p] = {garment.panels[p].name, "transform: flat, as in the file", kFlatClearance, 0};
     }
     if (clear) return out;
   }

@@ -73,7 +73,9 @@ void run_dress(const DressArgs& a) {
 
   std::fprintf(stderr, "dressing a %.2f m body (%zu triangles) in", static_cast<double>(body.measurements.height),
                body.mesh.triangle_count());
-  for (const GarmentRequest& r : requests) std::fprintf(stderr, " %s", r.spec.name.c_str());
+  for (const GarmentRequest& r : requests)
+    std::fprintf(stderr, " %s %s", r.spec.name.c_str(),
+                 (r.size.empty() ? choose_size(r.spec, body.measurements).size : r.size).c_str());
   std::fprintf(stderr, " (collision %s)\n", a.collision.c_str());
 
   Progress progress("dressing", 2.0 * static_cast<double>(requests.size()));
@@ -113,7 +115,9 @@ void add_dress_command(CLI::App& app) {
                   "build the body from measurements in metres, e.g. height=1.70,bust=0.92,waist=0.74,hips=0.98");
   cmd->add_option("--garment", args->garments,
                   "built-in garment name (see `drape garments`) or garment file; repeat for layers, outermost last");
-  cmd->add_option("--size", args->sizes, "size to make (one for all garments, or one per --garment)");
+  cmd->add_option("--size", args->sizes,
+                  "size to make (one for all garments, or one per --garment); default: the size whose size chart "
+                  "entry is nearest to the body's measurements (docs/garment-format.md), report.json says why");
   cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own");
   cmd->add_option("--collision", args->collision, "body collision: image (paper sec. 4.2), bvh (sec. 4.1) or sdf")
       ->capture_default_str()->check(CLI::IsMember({"image", "bvh", "sdf"}));

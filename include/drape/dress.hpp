@@ -68,6 +68,7 @@ struct PanelPlacement {
 // One garment put on the body.
 struct DressedGarment {
   std::string name, size, fabric;
+  std::string size_reason;  // why this size: asked for, nearest in the size chart, or the base size
   ClothModel model;
   ClothState state;
   std::vector<std::array<uint32_t, 2>> seam_pairs;  // particle pairs sewn together
@@ -107,11 +108,21 @@ struct DressResult {
   bool passed() const { return all_passed(gates); }
 };
 
-// A garment request: a loaded spec and the size to make (empty: the spec's base size).
+// A garment request: a loaded spec and the size to make (empty: the size for the body, choose_size).
 struct GarmentRequest {
   GarmentSpec spec;
   std::string size;
 };
+
+// The size a garment is made in for a body when none is asked for: the size whose size-chart entry
+// is nearest to the body's measurements (root mean square of the relative differences over the
+// entry's measurements, as a shop's size chart is read); the spec's base size when it has no chart
+// or the body has none of the chart's measurements. `reason` says which and by how much.
+struct SizeChoice {
+  std::string size;
+  std::string reason;
+};
+SizeChoice choose_size(const GarmentSpec& spec, const Measurements& body);
 
 // --- The stages ---------------------------------------------------------------------------------
 

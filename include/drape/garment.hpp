@@ -14,6 +14,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -101,7 +102,14 @@ struct SeamSpec {
   double ease = 0;
 };
 
+// A size chart: for each size, the body measurements it is drafted for (metres, by the body layer's
+// measurement keys: "bust", "waist", "hips", "shoulder_width", ...; see size_chart_keys()).
+using SizeMeasurements = std::map<std::string, double, std::less<>>;
+
 struct GarmentSpec {
+  // size_chart[k]: the body sizes[k] is drafted for; empty (or an empty entry) where the file gives
+  // none. The dressing picks the nearest size for the body when none is asked for (dress.hpp).
+  std::vector<SizeMeasurements> size_chart;
   std::string name;
   std::string source;        // file name for messages
   std::string format;        // "drape", "garmentcode", "garmentcode-2021", "dxf"
@@ -121,6 +129,8 @@ inline constexpr double kMaxSeamEase = 0.5;                // ease above this is
 
 // Fabric names the cloth model has presets for.
 const std::vector<std::string>& known_fabrics();
+// Keys a size chart may use: the body's girths and lengths that grade a pattern.
+const std::vector<std::string_view>& size_chart_keys();
 
 // Reads a garment file; the format is detected from the content: drape garment JSON, GarmentCode
 // specification, 2021 template JSON (with // comments), or an AAMA/ASTM DXF. Throws InputError

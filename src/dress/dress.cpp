@@ -69,9 +69,15 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   const auto clock = [] { return std::chrono::steady_clock::now(); };
   const auto since = [&](auto t) { return std::chrono::duration<double>(clock() - t).count(); };
 
-  // Sizes resolved and validated up front, so bad input stops the run before anything is simulated.
+  // Sizes resolved (the body's size where none is asked for) and validated up front, so bad input
+  // stops the run before anything is simulated.
   std::vector<Garment> garments;
-  for (const GarmentRequest& r : requests) garments.push_back(garment_in_size(r.spec, r.size));
+  std::vector<std::string> size_reasons;
+  for (const GarmentRequest& r : requests) {
+    const SizeChoice choice = r.size.empty() ? choose_size(r.spec, body.measurements) : SizeChoice{r.size, "asked for"};
+    garments.push_back(garment_in_size(r.spec, choice.size));
+    size_reasons.push_back(choice.reason);
+  }
 
   auto t0 = clock();
   std::unique_ptr<BodyCollider> body_collider = make_body_collider(body.mesh, o.collision);
@@ -82,6 +88,7 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   for (size_t i = 0; i < garments.size(); ++i) {
     t0 = clock();
     DressedGarment g = prepare_garment(body, garments[i], *body_collider, o);
+    g.size_reason = size_reasons[i];
     result.setup_seconds += since(t0);
     sew_and_drape(g, colliders, o, progress, i, garments.size());
     result.simulation.iterations += g.state.iterations;

@@ -61,6 +61,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
     for (size_t i = 0; i < seam_gap.size(); ++i) seams.push_back({{"seam", g.seam_names[i]}, {"max_gap_m", seam_gap[i]}});
     garments.push_back({{"name", g.name},
                         {"size", g.size},
+                        {"size_reason", g.size_reason},
                         {"fabric", g.fabric},
                         {"vertices", g.model.particle_count()},
                         {"springs", g.model.spring_count()},

@@ -298,6 +298,30 @@ GarmentSpec parse_drape_garment(const Json& root, const std::string& source, con
     }
   }
 
+  // The size chart: the body measurements each size is drafted for.
+  if (const Json* chart = optional_field(root, "size_chart")) {
+    if (!chart->is_object()) top.at("size_chart").fail("expected an object of size: {measurement: metres}");
+    spec.size_chart.assign(spec.sizes.size(), {});
+    for (const auto& [size, entry] : chart->items()) {
+      const Where ws = top.at("size_chart").at(fmt::format("size \"{}\"", size));
+      const auto it = std::find(spec.sizes.begin(), spec.sizes.end(), size);
+      if (it == spec.sizes.end()) ws.fail("is not one of the sizes");
+      if (!entry.is_object() || entry.empty()) ws.fail("expected an object of measurement: metres");
+      SizeMeasurements& m = spec.size_chart[static_cast<size_t>(it - spec.sizes.begin())];
+      for (const auto& [key, value] : entry.items()) {
+        const auto& keys = size_chart_keys();
+        if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+          std::string list;
+          for (std::string_view k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
+          ws.at(key).fail(fmt::format("unknown measurement (expected one of: {})", list));
+        }
+        const double metres = as_number(value, ws.at(key));
+        if (!(metres > 0.05 && metres < 3.0)) ws.at(key).fail("expected metres, between 0.05 and 3");
+        m[key] = metres;
+      }
+    }
+  }
+
   // Seams.
   if (const Json* seams = optional_field(root, "seams")) {
     if (!seams->is_array()) top.at("seams").fail("expected a list");

@@ -163,6 +163,14 @@ const std::vector<std::string>& known_fabrics() {
   return kFabrics;
 }
 
+// The body layer's measurement keys (drape/body.hpp, measurement_table) that a size chart may name;
+// a dressing test checks that each is one of them.
+const std::vector<std::string_view>& size_chart_keys() {
+  static const std::vector<std::string_view> kKeys = {"height", "neck", "bust", "underbust", "waist", "hips",
+                                                      "thigh", "upper_arm", "inseam", "shoulder_width"};
+  return kKeys;
+}
+
 Garment garment_in_size(const GarmentSpec& spec, std::string_view size) {
   const std::string& source = spec.source;
   size_t index = spec.base_size;

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
@@ -83,6 +85,31 @@ TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
   EXPECT_NE(std::find(failed.begin(), failed.end(), "settled"), failed.end()) << failed.dump();
   EXPECT_NE(std::find(failed.begin(), failed.end(), "seams_closed"), failed.end()) << failed.dump();
   EXPECT_FALSE(report["quality"]["settled"].get<bool>());
+}
+
+// With no --size each garment is made in the size its size chart gives the body (docs/garment-format.md):
+// the female-graded M on the default female body, the men's cut XL on the default male body; report.json
+// names the size and why. Capped at a few iterations: only the choice is under test here.
+TEST(DressCli, SizeComesFromTheBodyUnlessAskedFor) {
+  const auto dir = test::temp_dir("dress_size");
+  const auto size_of = [&](const std::string& args, const std::string& out) {
+    const auto r = test::run_drape("dress --max-iterations 2 " + args + " --out " + (dir / out).string());
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    const nlohmann::json report = read_json(dir / out / "report.json");
+    const auto& g = report["garments"][0];
+    return std::make_pair(g["size"].get<std::string>(), g["size_reason"].get<std::string>());
+  };
+  auto [size, why] = size_of("--body male", "male");
+  EXPECT_EQ(size, "XL");
+  EXPECT_NE(why.find("size chart"), std::string::npos) << why;
+  std::tie(size, why) = size_of("--body female", "female");
+  EXPECT_EQ(size, "M");
+  EXPECT_NE(why.find("size chart"), std::string::npos) << why;
+  std::tie(size, why) = size_of("--body male --garment skirt", "male_skirt");
+  EXPECT_EQ(size, "L");
+  std::tie(size, why) = size_of("--body male --size S", "male_s");
+  EXPECT_EQ(size, "S");
+  EXPECT_EQ(why, "asked for");
 }
 
 }  // namespace

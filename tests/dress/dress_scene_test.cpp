@@ -5,6 +5,7 @@
 // Under sanitizers (DRAPE_SANITIZED) only the default shirt on the default body runs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <map>
 #include <mutex>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "drape/dress.hpp"
+#include "drape/error.hpp"
 #include "dress/dress_support.hpp"
 #include "support/test_support.hpp"
 
@@ -69,6 +71,44 @@ TEST(DressScene, DefaultShirtOnDefaultBodyPassesTheGates) {
   EXPECT_LE(q.max_strain, r.garments[0].model.fabric.strain_threshold + 0.01f);
   EXPECT_TRUE(q.settled);
   EXPECT_TRUE(r.passed()) << failed_gates(r);
+}
+
+// The size for a body when none is asked for (choose_size, docs/garment-format.md "Size chart"): the
+// default female body wears the female-graded M of every built-in, the default male body the size
+// drafted for him; a garment without a chart, or a body without the chart's measurements, the base size.
+TEST(DressSize, EachDefaultBodyGetsItsSize) {
+  const std::map<std::string, std::string> male = {
+      {"shirt", "XL"}, {"dress", "XL"}, {"skirt", "L"}, {"trousers", "L"}, {"jeans", "L"}};
+  for (const BuiltinGarment& b : builtin_garments()) {
+    SCOPED_TRACE(b.name);
+    GarmentSpec spec = *builtin_garment(b.name);
+    const SizeChoice female_choice = choose_size(spec, cached_body(Sex::Female).measurements);
+    EXPECT_EQ(female_choice.size, "M");
+    EXPECT_NE(female_choice.reason.find("nearest in the size chart"), std::string::npos) << female_choice.reason;
+    ASSERT_TRUE(male.count(b.name));
+    EXPECT_EQ(choose_size(spec, cached_body(Sex::Male).measurements).size, male.at(b.name));
+    EXPECT_EQ(choose_size(spec, Measurements{}).size, b.default_size);  // nothing measured
+    spec.size_chart.clear();
+    EXPECT_EQ(choose_size(spec, cached_body(Sex::Male).measurements).size, b.default_size);
+  }
+}
+
+// Every key a size chart may use is a measurement the body layer takes, and an unknown one is refused
+// naming the file and the key.
+TEST(DressSize, ChartKeysAreBodyMeasurements) {
+  for (std::string_view key : size_chart_keys()) {
+    const auto& table = measurement_table();
+    EXPECT_TRUE(std::any_of(table.begin(), table.end(), [&](const MeasurementInfo& m) { return m.key == key; })) << key;
+  }
+  const std::string text = R"({"drape_garment": 1, "name": "t", "sizes": ["M"], "size_chart": {"M": {"bicep": 0.3}},
+                               "panels": [{"name": "p", "vertices": [[0, 0], [1, 0], [1, 1]]}]})";
+  try {
+    parse_garment(text, "chart.json");
+    ADD_FAILURE() << "an unknown size chart key was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("chart.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bicep"), std::string::npos) << e.what();
+  }
 }
 
 // The shirt's other sizes on the default (female) body. NOT YET on the male body: its shoulders
@@ -134,7 +174,7 @@ std::vector<Fit> not_yet() {
 }
 INSTANTIATE_TEST_SUITE_P(Garments, BuiltinNotYet, ::testing::ValuesIn(not_yet()), fit_name);
 
-// The default shirt on the MakeHuman-derived bodies and on GarmentCode's mean body (metres, +Y up).
+// The default shirt (M) on the MakeHuman-derived bodies and on GarmentCode's mean body (metres, +Y up).
 class SharedBody : public ::testing::TestWithParam<std::string> {};
 std::string body_stem(const ::testing::TestParamInfo<std::string>& p) {
   return std::filesystem::path(p.param).stem().string();
@@ -143,7 +183,7 @@ std::string body_stem(const ::testing::TestParamInfo<std::string>& p) {
 TEST_P(SharedBody, DefaultShirt) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const auto path = DRAPE_REQUIRE_SHARED(GetParam());
-  expect_dressed(load_body(path), default_garment_name(), "");
+  expect_dressed(load_body(path), default_garment_name(), "M");
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBody,
                          ::testing::Values("bodies/garmentcode/mean_all.obj", "bodies/makehuman/derived/mh_female_average.obj"),

@@ -106,6 +106,19 @@ struct SeamSpec {
 // measurement keys: "bust", "waist", "hips", "shoulder_width", ...; see size_chart_keys()).
 using SizeMeasurements = std::map<std::string, double, std::less<>>;
 
+// An elastic band sewn along outline edges (a waistband): a ring of springs along the edges,
+// relaxed at the wearer's waist girth times (1 + ease) (never longer than drafted), that gathers
+// the fabric sewn to it. With negative ease it is stretched round the body and holds the garment
+// up by its tension and friction; nothing is pinned (docs/garment-format.md, Elastic bands). An
+// edge sewn to a band edge is gathered with it.
+struct ElasticBand {
+  std::vector<SeamSide> edges;  // the band's edges, all the way round the garment
+  double ease = -0.05;          // relaxed girth / body waist girth - 1, in [-0.3, 0]
+  // The elastic is as stiff as `stiffness` strips of the garment's fabric `width` metres wide.
+  double width = 0.03;
+  double stiffness = 4.0;
+};
+
 struct GarmentSpec {
   // size_chart[k]: the body sizes[k] is drafted for; empty (or an empty entry) where the file gives
   // none. The dressing picks the nearest size for the body when none is asked for (dress.hpp).
@@ -120,6 +133,7 @@ struct GarmentSpec {
   size_t base_size = 0;
   std::vector<PanelSpec> panels;
   std::vector<SeamSpec> seams;
+  std::vector<ElasticBand> bands;
 };
 
 // Seam sides may differ in length by this much plus the seam's ease (see docs/garment-format.md).
@@ -198,6 +212,7 @@ struct Garment {
   int layer = 0;
   std::vector<Panel> panels;
   std::vector<SeamSpec> seams;
+  std::vector<ElasticBand> bands;
 
   double seam_side_length(const SeamSide& side) const;
 };

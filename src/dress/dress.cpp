@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "dress/stages.hpp"
+#include "dress/waistband.hpp"
 #include "drape/error.hpp"
 
 namespace drape {
@@ -17,6 +18,7 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   const GarmentMesh mesh = mesh_garment(garment, o.mesh);
   dressing::PlacedPanels placed = dressing::place_panels(body, garment, mesh, body_collider, fabric.collision_thickness);
   dressing::GarmentCloth cloth = dressing::garment_cloth_spec(garment, mesh, placed, fabric);
+  dressing::gather_elastic_bands(body, garment, mesh, placed, cloth);
   g.model = compile(std::move(cloth.spec));
   g.state = initial_state(g.model);
   g.seam_pairs = std::move(cloth.seam_pairs);

@@ -346,6 +346,33 @@ GarmentSpec parse_drape_garment(const Json& root, const std::string& source, con
       spec.seams.push_back(seam);
     }
   }
+
+  // Elastic bands (a waistband): edges as seam sides, ease against the body's girth, width.
+  if (const Json* bands = optional_field(root, "bands")) {
+    if (!bands->is_array()) top.at("bands").fail("expected a list");
+    for (size_t i = 0; i < bands->size(); ++i) {
+      const Json& b = (*bands)[i];
+      const Where wb = top.at(fmt::format("bands[{}]", i));
+      const Json& edges = field(b, "edges", wb);
+      if (!edges.is_array() || edges.empty()) wb.at("edges").fail("expected a list of {\"panel\", \"edge\"}");
+      ElasticBand band;
+      for (size_t k = 0; k < edges.size(); ++k)
+        band.edges.push_back(parse_seam_side(edges[k], spec, wb.at(fmt::format("edges[{}]", k))));
+      if (const Json* e = optional_field(b, "ease")) {
+        band.ease = as_number(*e, wb.at("ease"));
+        if (band.ease < -0.3 || band.ease > 0) wb.at("ease").fail("must be between -0.3 and 0 (a fraction of the body's girth)");
+      }
+      if (const Json* w = optional_field(b, "width")) {
+        band.width = as_number(*w, wb.at("width"));
+        if (band.width <= 0 || band.width > 0.2) wb.at("width").fail("must be between 0 and 0.2 m");
+      }
+      if (const Json* k = optional_field(b, "stiffness")) {
+        band.stiffness = as_number(*k, wb.at("stiffness"));
+        if (band.stiffness <= 0 || band.stiffness > 100) wb.at("stiffness").fail("must be between 0 and 100 (strips of the fabric)");
+      }
+      spec.bands.push_back(std::move(band));
+    }
+  }
   return spec;
 }
 

@@ -197,6 +197,7 @@ Garment garment_in_size(const GarmentSpec& spec, std::string_view size) {
   g.fabric = spec.fabric;
   g.layer = spec.layer;
   g.seams = spec.seams;
+  g.bands = spec.bands;
   if (spec.panels.empty()) throw InputError(source, "garment has no panels");
   const std::string size_note = spec.sizes.size() > 1 ? fmt::format(" (size {})", g.size) : std::string();
   for (const PanelSpec& ps : spec.panels) {

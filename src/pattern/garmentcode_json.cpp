@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 
 #include "pattern/garment_formats.hpp"
@@ -208,6 +209,48 @@ GarmentSpec parse_garmentcode(const Json& root, const std::string& source) {
       spec.seams.push_back(seam);
     }
   }
+
+  // GarmentCode's simulator attaches the edges labelled `lower_interface` (a skirt's waistband,
+  // a dress's waist seam) to the body; drape has nothing that holds vertices in place, so they
+  // become an elastic band (ElasticBand: a little smaller than the body's girth where it sits,
+  // held up by its tension and friction).
+  ElasticBand band;
+  for (size_t p = 0; p < spec.panels.size(); ++p)
+    for (size_t k = 0; k < spec.panels[p].edges.size(); ++k)
+      if (spec.panels[p].edges[k].name == "lower_interface")
+        band.edges.push_back({static_cast<uint32_t>(p), static_cast<uint32_t>(k), 1});
+  // The 2021 templates label no edges. A bottom (every panel below kBottomTop of the pelvis
+  // origin: skirts, trousers) has its waist where its unsewn edges reach the garment's top: those
+  // are its band.
+  if (is_2021) {
+    constexpr double kBottomTop = 0.15, kAtTop = 0.02;  // metres
+    std::vector<std::vector<double>> height(spec.panels.size());  // per panel, per loop vertex
+    double garment_top = -std::numeric_limits<double>::max();
+    for (size_t p = 0; p < spec.panels.size(); ++p) {
+      const PanelTransform& t = *spec.panels[p].transform;
+      const Eigen::Matrix3d rot = (Eigen::AngleAxisd(t.rotation_deg.z() * M_PI / 180, Vec3d::UnitZ()) *
+                                   Eigen::AngleAxisd(t.rotation_deg.y() * M_PI / 180, Vec3d::UnitY()) *
+                                   Eigen::AngleAxisd(t.rotation_deg.x() * M_PI / 180, Vec3d::UnitX())).toRotationMatrix();
+      for (const Vec2d& v : spec.panels[p].vertices[0]) {
+        height[p].push_back((rot * Vec3d(v.x(), v.y(), 0) + t.translation).y());
+        garment_top = std::max(garment_top, height[p].back());
+      }
+    }
+    std::vector<std::vector<bool>> sewn(spec.panels.size());
+    for (size_t p = 0; p < spec.panels.size(); ++p) sewn[p].assign(spec.panels[p].edges.size(), false);
+    for (const SeamSpec& seam : spec.seams) {
+      sewn[seam.a.panel][seam.a.first_edge] = true;
+      sewn[seam.b.panel][seam.b.first_edge] = true;
+    }
+    if (garment_top < kBottomTop && band.edges.empty())
+      for (size_t p = 0; p < spec.panels.size(); ++p) {
+        const size_t n = height[p].size();
+        for (size_t k = 0; k < n; ++k)
+          if (!sewn[p][k] && height[p][k] > garment_top - kAtTop && height[p][(k + 1) % n] > garment_top - kAtTop)
+            band.edges.push_back({static_cast<uint32_t>(p), static_cast<uint32_t>(k), 1});
+      }
+  }
+  if (!band.edges.empty()) spec.bands.push_back(std::move(band));
   return spec;
 }
 

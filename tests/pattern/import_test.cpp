@@ -177,5 +177,64 @@ TEST(Import, DxfCompanionSewsPieces) {
   EXPECT_EQ(gm.seam_pairs.size() % 2, 0u);
 }
 
+// Elastic bands. GarmentCode's `lower_interface` edges (which its simulator attaches to the body)
+// become a band: the flare skirt's waistband top edges, 0.84 m round; a 2021 bottom's unsewn top
+// edges (the trousers' four waist edges, 0.80 m); a top (the tee) gets none.
+TEST(Import, WaistEdgesBecomeAnElasticBand) {
+  const auto flare = DRAPE_REQUIRE_SHARED("patterns/garmentcode/flare_skirt_specification.json");
+  const auto pants = DRAPE_REQUIRE_SHARED("patterns/garment_pattern_generator_2021/pants_straight_sides.json");
+  const auto tee = DRAPE_REQUIRE_SHARED("patterns/garment_pattern_generator_2021/tee.json");
+  const auto band_length = [](const Garment& g) {
+    EXPECT_EQ(g.bands.size(), 1u);
+    double length = 0;
+    if (g.bands.empty()) return length;
+    for (const SeamSide& side : g.bands[0].edges) {
+      EXPECT_EQ(side.edge_count, 1u);
+      length += g.panels[side.panel].edges[side.first_edge].length();
+    }
+    return length;
+  };
+  const Garment skirt = garment_in_size(read_garment(flare));
+  EXPECT_NEAR(band_length(skirt), 0.843, 0.005);
+  for (const SeamSide& side : skirt.bands[0].edges) EXPECT_EQ(skirt.panels[side.panel].edge_names[side.first_edge], "lower_interface");
+  const Garment trousers = garment_in_size(read_garment(pants));
+  EXPECT_EQ(trousers.bands.at(0).edges.size(), 4u);
+  EXPECT_NEAR(band_length(trousers), 0.80, 0.005);
+  EXPECT_TRUE(garment_in_size(read_garment(tee)).bands.empty());
+}
+
+// A drape garment file declares bands by edge, with ease, width and stiffness; bad values are
+// refused naming the file and the field.
+TEST(Import, DrapeGarmentBandsAreReadAndChecked) {
+  const std::string head = R"({"drape_garment": 1, "name": "tube", "fabric": "jersey",
+      "panels": [{"name": "front", "vertices": [[0, 0], [0.4, 0], [0.4, 0.3], [0, 0.3]], "edges": [{}, {}, {"name": "waist"}, {}]},
+                 {"name": "back", "vertices": [[0, 0], [0.4, 0], [0.4, 0.3], [0, 0.3]], "edges": [{}, {}, {"name": "waist"}, {}]}],
+      "seams": [{"a": {"panel": "front", "edge": 1}, "b": {"panel": "back", "edge": 3}},
+                {"a": {"panel": "front", "edge": 3}, "b": {"panel": "back", "edge": 1}}],
+      "bands": [{"edges": [{"panel": "front", "edge": "waist"}, {"panel": "back", "edge": "waist"}])";
+  const GarmentSpec spec = parse_garment(head + R"(, "ease": -0.08, "width": 0.04, "stiffness": 6}]})", "tube.json");
+  ASSERT_EQ(spec.bands.size(), 1u);
+  EXPECT_EQ(spec.bands[0].edges.size(), 2u);
+  EXPECT_EQ(spec.bands[0].edges[1].panel, 1u);
+  EXPECT_EQ(spec.bands[0].edges[1].first_edge, 2u);
+  EXPECT_DOUBLE_EQ(spec.bands[0].ease, -0.08);
+  EXPECT_DOUBLE_EQ(spec.bands[0].width, 0.04);
+  EXPECT_DOUBLE_EQ(spec.bands[0].stiffness, 6.0);
+  EXPECT_EQ(garment_in_size(spec).bands.size(), 1u);
+  for (const char* bad : {R"(, "ease": 0.1}]})", R"(, "width": 0}]})", R"(, "stiffness": -1}]})"}) {
+    try {
+      parse_garment(head + bad, "tube.json");
+      ADD_FAILURE() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("tube.json"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bands[0]"), std::string::npos) << e.what();
+    }
+  }
+  const std::string unknown_panel = R"({"drape_garment": 1, "name": "tube",
+      "panels": [{"name": "front", "vertices": [[0, 0], [0.4, 0], [0.4, 0.3], [0, 0.3]]}],
+      "bands": [{"edges": [{"panel": "side", "edge": 0}]}]})";
+  EXPECT_THROW(parse_garment(unknown_panel, "tube.json"), InputError);
+}
+
 }  // namespace
 }  // namespace drape

@@ -230,6 +230,7 @@ class StepScratch {
   std::vector<float> block_speed;         // per block: max speed squared
   std::vector<uint32_t> block_count;      // per block: counters (contacts, corrections)
   std::vector<uint32_t> active_spring;    // strain-limited springs near the limit (converge passes)
+  std::vector<uint32_t> changed_in_pass;  // per particle: 1 + the strain pass that last changed it
   size_t max_colliders = 0;
 };
 

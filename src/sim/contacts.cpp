@@ -37,7 +37,7 @@ void detect_contacts(const StepContext& c, std::span<Collider* const> colliders)
   });
 }
 
-uint64_t respond_to_contacts(const StepContext& c) {
+uint64_t respond_to_contacts(const StepContext& c, uint32_t* changed, uint32_t mark) {
   const ClothModel& m = c.model;
   Vec3f* x = c.state.x.data();
   Vec3f* v = c.state.v.data();
@@ -53,10 +53,12 @@ uint64_t respond_to_contacts(const StepContext& c) {
     for (size_t i = begin; i < end; ++i) {
       ContactSample& s = contact[i];
       if (w[i] == 0 || !(s.distance < std::numeric_limits<float>::infinity())) continue;
-      contacts += respond_contact_velocity(x[i], v[i], s.distance, s.normal, s.velocity, f.collision_thickness,
-                                           friction, f.restitution, dt)
-                      ? 1u
-                      : 0u;
+      const Vec3f x0 = x[i], v0 = v[i];
+      if (respond_contact_velocity(x[i], v[i], s.distance, s.normal, s.velocity, f.collision_thickness, friction,
+                                   f.restitution, dt)) {
+        ++contacts;
+        if (changed && (x[i] != x0 || v[i] != v0)) changed[i] = mark;
+      }
       // A particle put back on the thickness layer is now at the thickness (a second call is velocity-only).
       s.distance = std::max(s.distance, f.collision_thickness);
     }

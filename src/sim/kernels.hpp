@@ -29,9 +29,23 @@ inline Vec3f spring_force(const Vec3f& xa, const Vec3f& xb, const Vec3f& va, con
 // is what lets one pass hold a long hanging chain (every spring stops its own lower end), and it
 // also means the modification dissipates energy, which draping wants. Returns true if it
 // changed a velocity by more than `tolerance` / dt along the spring.
+// Most springs are well short of the limit and slow: velocity_limit_idle() rules those out without
+// a square root or a division, with a margin over rounding, so the result is the same bit for bit.
+inline bool velocity_limit_idle(const Vec3f& d, const Vec3f& dv, float max_length, float dt) {
+  // len < max and |dv| dt < max - len: the spring cannot reach max_length within dt, excess <= 0.
+  // max - len = (max^2 - len^2) / (max + len) >= (max^2 - len^2) / (2 max), so it is enough that
+  // 4 |dv|^2 dt^2 max^2 < (max^2 - len^2)^2; len^2 < 0.999 max^2 and the 1 % factor keep the float
+  // evaluation of both sides far from the rounding that could decide the exact test differently.
+  const float max2 = max_length * max_length, len2 = d.squaredNorm();
+  if (!(len2 < 0.999f * max2)) return false;
+  const float gap2 = max2 - len2;
+  return 4.04f * dv.squaredNorm() * (dt * dt) * max2 < gap2 * gap2;
+}
+
 inline bool limit_spring_velocity(const Vec3f& xa, const Vec3f& xb, Vec3f& va, Vec3f& vb, float wa, float wb,
                                   float max_length, float dt, float tolerance) {
   const Vec3f d = xb - xa;
+  if (velocity_limit_idle(d, vb - va, max_length, dt)) return false;
   const float len = d.norm();
   if (len <= 0) return false;
   const Vec3f u = d / len;

@@ -26,7 +26,8 @@ struct StrainLimitResult {
 void update_colliders(std::span<Collider* const> colliders, double time);
 void detect_contacts(const StepContext& c, std::span<Collider* const> colliders);
 uint64_t apply_contact_forces(const StepContext& c);
-uint64_t respond_to_contacts(const StepContext& c);
+// changed (optional, per particle): set to `mark` where the response changed a position or velocity.
+uint64_t respond_to_contacts(const StepContext& c, uint32_t* changed = nullptr, uint32_t mark = 0);
 
 // forces.cpp: per-spring forces, then per-particle gather + external forces + velocity update.
 void compute_spring_forces(const StepContext& c);

@@ -77,6 +77,7 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_speed.assign(blocks, 0.0f);
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
+  changed_in_pass.assign(model.particle_count(), 0u);
   max_colliders = colliders;
 }
 
@@ -108,6 +109,7 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
   if (state.status != StepStatus::Ok) return state.status;
   if (state.x.size() != model.particle_count() || state.v.size() != model.particle_count() ||
       scratch.spring_force.size() != model.spring_count() || scratch.contact.size() != model.particle_count() ||
+      scratch.changed_in_pass.size() != model.particle_count() ||
       colliders.size() > std::max<size_t>(scratch.max_colliders, 1) ||
       (colliders.size() > 1 && scratch.contact_tmp.size() != model.particle_count()))
     throw std::invalid_argument("step: state or scratch was not made for this model and collider count");

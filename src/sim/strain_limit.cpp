@@ -16,6 +16,8 @@
 // Rings converge slowly under Gauss-Seidel (see the converge passes below): the position passes can
 // continue over only the springs still near the limit until none is over it
 // (StepSettings::converge_passes).
+#include <algorithm>
+
 #include "sim/kernels.hpp"
 #include "sim/parallel.hpp"
 #include "sim/stages.hpp"
@@ -26,12 +28,29 @@ namespace {
 constexpr float kRelativeTolerance = 1e-4f;
 constexpr float kJoinedTolerance = 1e-5f;  // m: a joined pair this close counts as held
 
+// What one spring's kernel did: nothing, a change within the tolerance, or a correction beyond it
+// (counted; a pass with none ends the passes).
+enum class Change : uint8_t { None, Small, Corrected };
+
+// Passes after the first visit only the springs with an end that changed since their last visit:
+// every particle carries the pass that last changed it (changed_in_pass, 1 + pass index), written
+// wherever a spring, a joined pair or the after-pass step (contacts) changed it at all. A spring
+// whose ends did not change since its last visit, which changed nothing (a change marks its own
+// ends), would compute the same nothing again: skipping it gives the same result bit for bit
+// (tests/sim/fast_paths_test.cpp). Marking only the changes beyond the tolerance would skip more,
+// but a change within it can be 5 mm/s, and leaving its neighbours alone kept the skirt from settling.
 template <class Kernel, class Hold, class AfterPass>
 StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kernel, Hold&& hold, AfterPass&& after_pass) {
   const ClothModel& m = c.model;
   StrainLimitResult result;
   const size_t colours = m.limit_colour_begin.empty() ? 0 : m.limit_colour_begin.size() - 1;
+  uint32_t* changed = c.scratch.changed_in_pass.data();
+  const uint32_t* limit_a = m.limit_a.data();
+  const uint32_t* limit_b = m.limit_b.data();
+  std::fill(c.scratch.changed_in_pass.begin(), c.scratch.changed_in_pass.end(), 0u);
   for (int pass = 0; pass < max_passes; ++pass) {
+    // A spring is visited if an end changed in the previous pass (mark == pass) or in this one.
+    const uint32_t since = static_cast<uint32_t>(pass), mark = since + 1;
     uint64_t corrections = 0;
     for (size_t colour = 0; colour < colours; ++colour) {
       const size_t first = m.limit_colour_begin[colour], count = m.limit_colour_begin[colour + 1] - first;
@@ -40,11 +59,22 @@ StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kern
       for (std::ptrdiff_t b = 0; b < blocks; ++b) {
         const size_t begin = first + static_cast<size_t>(b) * kBlock;
         const size_t end = std::min(first + count, begin + kBlock);
-        for (size_t s = begin; s < end; ++s) corrections += kernel(s) ? 1u : 0u;
+        for (size_t s = begin; s < end; ++s) {
+          const uint32_t a = limit_a[s], e = limit_b[s];
+          if (pass > 0 && changed[a] < since && changed[e] < since) continue;
+          const Change change = kernel(s);
+          if (change == Change::None) continue;
+          changed[a] = changed[e] = mark;
+          corrections += change == Change::Corrected ? 1u : 0u;
+        }
       }
     }
-    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
-    if (corrections > 0) after_pass();  // nothing changed: nothing to answer
+    for (const auto& [a, b] : c.settings.joined_pairs)
+      if (hold(a, b)) {
+        changed[a] = changed[b] = mark;
+        ++corrections;
+      }
+    if (corrections > 0) after_pass(changed, mark);  // nothing changed: nothing to answer
     ++result.passes;
     result.corrections += corrections;
     result.at_pass_limit = corrections > 0;
@@ -64,11 +94,14 @@ StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contac
   return run_passes(c, c.settings.strain_passes, [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
-    return limit_spring_velocity(x[a], x[b], v[a], v[b], w[a], w[b], stretch * rest, dt, kRelativeTolerance * rest);
+    const Vec3f va = v[a], vb = v[b];
+    if (limit_spring_velocity(x[a], x[b], v[a], v[b], w[a], w[b], stretch * rest, dt, kRelativeTolerance * rest))
+      return Change::Corrected;
+    return v[a] != va || v[b] != vb ? Change::Small : Change::None;
   }, [&](uint32_t a, uint32_t b) {
     return hold_pair_velocity(x[a], x[b], v[a], v[b], w[a], w[b], dt, kJoinedTolerance);
-  }, [&] {
-    if (answer_contacts) respond_to_contacts(c);
+  }, [&](uint32_t* changed, uint32_t mark) {
+    if (answer_contacts) respond_to_contacts(c, changed, mark);
   });
 }
 
@@ -80,10 +113,12 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   const auto limit = [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
-    return limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest);
+    const Vec3f xa = x[a], xb = x[b];
+    if (limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest)) return Change::Corrected;
+    return x[a] != xa || x[b] != xb ? Change::Small : Change::None;
   };
   const auto hold = [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); };
-  StrainLimitResult result = run_passes(c, max_passes, limit, hold, [] {});
+  StrainLimitResult result = run_passes(c, max_passes, limit, hold, [](uint32_t*, uint32_t) {});
   if (!result.at_pass_limit || converge_passes <= 0) return result;
 
   // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, in index
@@ -104,25 +139,39 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   uint32_t* active = c.scratch.active_spring.data();
   Vec3f* v = c.state.v.data();
   const float inv_dt = 1.0f / c.dt;
+  // As in run_passes, a pass after the gathering one visits only the springs with an end that a
+  // spring or a joined pair changed since (changed_in_pass continues the regular passes'
+  // numbering); the gathering pass visits the whole set, since it may hold springs not visited yet.
+  uint32_t* changed = c.scratch.changed_in_pass.data();
+  const uint32_t first_mark = result.passes;
   size_t count = 0;
   for (int pass = 0; pass < converge_passes; ++pass) {
-    if (pass % kRegather == 0) {
+    const bool gather = pass % kRegather == 0;
+    if (gather) {
       count = 0;
       for (size_t s = 0; s < m.limit_a.size(); ++s) {
         const float near = (stretch - kNearLimit) * m.limit_rest[s];
         if ((x[m.limit_b[s]] - x[m.limit_a[s]]).squaredNorm() > near * near) active[count++] = static_cast<uint32_t>(s);
       }
     }
+    const uint32_t since = first_mark + static_cast<uint32_t>(pass), mark = since + 1;
     uint64_t corrections = 0;
     for (size_t k = 0; k < count; ++k) {
       const uint32_t a = m.limit_a[active[k]], b = m.limit_b[active[k]];
+      if (!gather && changed[a] < since && changed[b] < since) continue;
       const Vec3f xa = x[a], xb = x[b];
       const float rest = m.limit_rest[active[k]];
       corrections += limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kConvergeTolerance * rest) ? 1u : 0u;
+      if (x[a] == xa && x[b] == xb) continue;
+      changed[a] = changed[b] = mark;
       v[a] += (x[a] - xa) * inv_dt;
       v[b] += (x[b] - xb) * inv_dt;
     }
-    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
+    for (const auto& [a, b] : c.settings.joined_pairs)
+      if (hold(a, b)) {
+        changed[a] = changed[b] = mark;
+        ++corrections;
+      }
     ++result.passes;
     result.corrections += corrections;
     result.at_pass_limit = corrections > 0;

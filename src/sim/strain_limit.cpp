@@ -39,7 +39,10 @@ enum class Change : uint8_t { None, Small, Corrected };
 // ends), would compute the same nothing again: skipping it gives the same result bit for bit
 // (tests/sim/fast_paths_test.cpp). Marking only the changes beyond the tolerance would skip more,
 // but a change within it can be 5 mm/s, and leaving its neighbours alone kept the skirt from settling.
-template <class Kernel, class Hold, class AfterPass>
+// Only the velocity passes skip: in the position passes, springs held at the limit move by rounding
+// on nearly every visit, so the marks skipped little and cost more than they saved (measured on
+// the shirt, bench_cloth BM_ShirtDrapeStep).
+template <bool kSkipUnchanged, class Kernel, class Hold, class AfterPass>
 StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kernel, Hold&& hold, AfterPass&& after_pass) {
   const ClothModel& m = c.model;
   StrainLimitResult result;
@@ -47,7 +50,7 @@ StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kern
   uint32_t* changed = c.scratch.changed_in_pass.data();
   const uint32_t* limit_a = m.limit_a.data();
   const uint32_t* limit_b = m.limit_b.data();
-  std::fill(c.scratch.changed_in_pass.begin(), c.scratch.changed_in_pass.end(), 0u);
+  if (kSkipUnchanged) std::fill(c.scratch.changed_in_pass.begin(), c.scratch.changed_in_pass.end(), 0u);
   for (int pass = 0; pass < max_passes; ++pass) {
     // A spring is visited if an end changed in the previous pass (mark == pass) or in this one.
     const uint32_t since = static_cast<uint32_t>(pass), mark = since + 1;
@@ -61,17 +64,17 @@ StrainLimitResult run_passes(const StepContext& c, int max_passes, Kernel&& kern
         const size_t end = std::min(first + count, begin + kBlock);
         for (size_t s = begin; s < end; ++s) {
           const uint32_t a = limit_a[s], e = limit_b[s];
-          if (pass > 0 && changed[a] < since && changed[e] < since) continue;
+          if (kSkipUnchanged && pass > 0 && changed[a] < since && changed[e] < since) continue;
           const Change change = kernel(s);
           if (change == Change::None) continue;
-          changed[a] = changed[e] = mark;
+          if (kSkipUnchanged) changed[a] = changed[e] = mark;
           corrections += change == Change::Corrected ? 1u : 0u;
         }
       }
     }
     for (const auto& [a, b] : c.settings.joined_pairs)
       if (hold(a, b)) {
-        changed[a] = changed[b] = mark;
+        if (kSkipUnchanged) changed[a] = changed[b] = mark;
         ++corrections;
       }
     if (corrections > 0) after_pass(changed, mark);  // nothing changed: nothing to answer
@@ -91,7 +94,7 @@ StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contac
   Vec3f* v = c.state.v.data();
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold, dt = c.dt;
-  return run_passes(c, c.settings.strain_passes, [&](size_t s) {
+  return run_passes<true>(c, c.settings.strain_passes, [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
     const Vec3f va = v[a], vb = v[b];
@@ -113,12 +116,11 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   const auto limit = [&](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
-    const Vec3f xa = x[a], xb = x[b];
-    if (limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest)) return Change::Corrected;
-    return x[a] != xa || x[b] != xb ? Change::Small : Change::None;
+    return limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest) ? Change::Corrected
+                                                                                                 : Change::None;
   };
   const auto hold = [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); };
-  StrainLimitResult result = run_passes(c, max_passes, limit, hold, [](uint32_t*, uint32_t) {});
+  StrainLimitResult result = run_passes<false>(c, max_passes, limit, hold, [](uint32_t*, uint32_t) {});
   if (!result.at_pass_limit || converge_passes <= 0) return result;
 
   // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, in index
@@ -139,39 +141,25 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   uint32_t* active = c.scratch.active_spring.data();
   Vec3f* v = c.state.v.data();
   const float inv_dt = 1.0f / c.dt;
-  // As in run_passes, a pass after the gathering one visits only the springs with an end that a
-  // spring or a joined pair changed since (changed_in_pass continues the regular passes'
-  // numbering); the gathering pass visits the whole set, since it may hold springs not visited yet.
-  uint32_t* changed = c.scratch.changed_in_pass.data();
-  const uint32_t first_mark = result.passes;
   size_t count = 0;
   for (int pass = 0; pass < converge_passes; ++pass) {
-    const bool gather = pass % kRegather == 0;
-    if (gather) {
+    if (pass % kRegather == 0) {
       count = 0;
       for (size_t s = 0; s < m.limit_a.size(); ++s) {
         const float near = (stretch - kNearLimit) * m.limit_rest[s];
         if ((x[m.limit_b[s]] - x[m.limit_a[s]]).squaredNorm() > near * near) active[count++] = static_cast<uint32_t>(s);
       }
     }
-    const uint32_t since = first_mark + static_cast<uint32_t>(pass), mark = since + 1;
     uint64_t corrections = 0;
     for (size_t k = 0; k < count; ++k) {
       const uint32_t a = m.limit_a[active[k]], b = m.limit_b[active[k]];
-      if (!gather && changed[a] < since && changed[b] < since) continue;
       const Vec3f xa = x[a], xb = x[b];
       const float rest = m.limit_rest[active[k]];
       corrections += limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kConvergeTolerance * rest) ? 1u : 0u;
-      if (x[a] == xa && x[b] == xb) continue;
-      changed[a] = changed[b] = mark;
       v[a] += (x[a] - xa) * inv_dt;
       v[b] += (x[b] - xb) * inv_dt;
     }
-    for (const auto& [a, b] : c.settings.joined_pairs)
-      if (hold(a, b)) {
-        changed[a] = changed[b] = mark;
-        ++corrections;
-      }
+    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
     ++result.passes;
     result.corrections += corrections;
     result.at_pass_limit = corrections > 0;

@@ -32,7 +32,12 @@ void run_list() {
   for (const BuiltinGarment& b : builtin_garments()) {
     std::string sizes;
     for (const std::string& s : b.sizes) sizes += (sizes.empty() ? "" : " ") + s;
-    fmt::print("{:<10} sizes {:<18} (default {}){}\n           {}\n", b.name, sizes, b.default_size,
+    // A garment with a size chart is made in the size drafted for the body being dressed
+    // (choose_size); its base size is what `garment check` and `garment mesh` show.
+    const std::optional<GarmentSpec> spec = builtin_garment(b.name);
+    const bool charted = spec && !spec->size_chart.empty();
+    fmt::print("{:<10} sizes {:<18} ({} {}){}\n           {}\n", b.name, sizes,
+               charted ? "size from the body's measurements by its size chart; base" : "default", b.default_size,
                b.name == default_garment_name() ? " [default garment]" : "", b.description);
   }
 }

@@ -240,6 +240,14 @@ class StepScratch {
 StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* const> colliders,
                 const StepSettings& settings, StepScratch& scratch, StepProfile* profile = nullptr);
 
+// Pulls every strain-limited spring longer than (1 + settings.strain_threshold) l0 back to that
+// length, and every pair in settings.joined_pairs together, by Gauss-Seidel position passes (at
+// most `max_passes`, until nothing is over by more than 0.1 % strain); velocities are left as they
+// are. For a change of regime, not for every step: a garment that the seam forces pulled past the
+// limit while sewing is relaxed once before gravity and the converge passes (whose corrections go
+// into the velocities) take over. Returns the passes run.
+int relax_to_strain_limit(const ClothModel& model, ClothState& state, const StepSettings& settings, int max_passes);
+
 // --- Measurements -------------------------------------------------------------------------------
 
 // Stretch (l - l0) / l0 of one kind's springs (structural by default).

@@ -84,6 +84,8 @@ struct DressedGarment {
 
   // Measured on the way.
   uint64_t sewing_iterations = 0, drape_iterations = 0;
+  float sewn_max_strain = 0;   // structural strain when sewing ended (the seams may pull past the limit)
+  int relax_passes = 0;        // position passes that relaxed the sewn garment to the strain limit (0: none needed)
   double sewing_seconds = 0, drape_seconds = 0;  // wall
   bool seams_closed = false, settled = false;
   StepStatus status = StepStatus::Ok;

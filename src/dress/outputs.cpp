@@ -77,6 +77,8 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"max_strain", st.max},
                         {"p99_strain", st.p99},
                         {"sewing_iterations", g.sewing_iterations},
+                        {"sewn_max_strain", g.sewn_max_strain},
+                        {"relax_passes", g.relax_passes},
                         {"drape_iterations", g.drape_iterations},
                         {"sewing_wall_seconds", g.sewing_seconds},
                         {"drape_wall_seconds", g.drape_seconds},

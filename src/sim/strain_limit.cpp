@@ -169,3 +169,28 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
 }
 
 }  // namespace drape::sim
+
+namespace drape {
+
+int relax_to_strain_limit(const ClothModel& m, ClothState& state, const StepSettings& settings, int max_passes) {
+  constexpr float kTolerance = 1e-3f;  // strain over the limit that still counts (converge passes')
+  Vec3f* x = state.x.data();
+  const float* w = m.inverse_mass.data();
+  const float stretch = 1.0f + settings.strain_threshold;
+  int pass = 0;
+  while (pass < max_passes) {
+    ++pass;
+    bool changed = false;
+    for (size_t s = 0; s < m.limit_a.size(); ++s) {
+      const float rest = m.limit_rest[s];
+      changed |= sim::limit_spring_position(x[m.limit_a[s]], x[m.limit_b[s]], w[m.limit_a[s]], w[m.limit_b[s]],
+                                            stretch * rest, kTolerance * rest);
+    }
+    for (const auto& [a, b] : settings.joined_pairs)
+      changed |= sim::hold_pair_position(x[a], x[b], w[a], w[b], sim::kJoinedTolerance);
+    if (!changed) break;
+  }
+  return pass;
+}
+
+}  // namespace drape

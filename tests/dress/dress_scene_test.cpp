@@ -113,6 +113,24 @@ TEST(DressSize, ChartKeysAreBodyMeasurements) {
 
 // The shirt's other sizes on the default (female) body. NOT YET on the male body: its shoulders
 // and neck are wider than the pattern's (the shoulder seams stay ~2-3 cm open), see docs/dressing.md.
+// At twice the paper's resolution (--edge 0.013, ~5100 vertices) the seam forces leave the sewn
+// shirt 7.5 % over its strain limit; draping's converge passes, whose corrections go into the
+// velocities, used to turn that into a first draping step over 50 m/s (reported as an explosion).
+// The sewn garment is now relaxed to the limit first (sewing.cpp) and dresses like the default one.
+TEST(DressScene, FinerShirtIsRelaxedBeforeDrapingAndPassesTheGates) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  DressOptions o;
+  o.mesh.edge_length = 0.013;
+  const DressResult r = dress(cached_body(Sex::Female), {{load_garment(default_garment_name()), ""}}, o);
+  ASSERT_EQ(r.garments.size(), 1u);
+  const DressedGarment& g = r.garments[0];
+  EXPECT_GT(g.model.particle_count(), 4000u);
+  EXPECT_GT(g.sewn_max_strain, g.model.fabric.strain_threshold + 0.01f);
+  EXPECT_GT(g.relax_passes, 0);
+  expect_sound(r);
+  EXPECT_TRUE(r.passed()) << failed_gates(r);
+}
+
 TEST(DressScene, ShirtOtherSizesOnDefaultBody) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   for (const char* size : {"S", "L"}) expect_dressed(cached_body(Sex::Female), "shirt", size);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -139,6 +140,33 @@ TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
   };
   EXPECT_GT(ring_strain(0), threshold + 0.02f);
   EXPECT_LT(ring_strain(256), threshold + 0.001f);
+}
+
+// relax_to_strain_limit: a sheet stretched 20 % is pulled back to the threshold by positions alone,
+// velocities untouched, and a joined pair is brought together; a sheet within the limit is untouched.
+TEST(ClothPhysics, RelaxToStrainLimitMovesPositionsOnly) {
+  const ClothModel m = test_grid();
+  constexpr float threshold = 0.05f;
+  ClothState s = perturbed(m, 0.0f);
+  for (Vec3f& x : s.x) x *= 1.2f;
+  const std::vector<Vec3f> velocities = s.v;
+  StepSettings settings = default_step_settings(m);
+  settings.strain_threshold = threshold;
+  const std::array<uint32_t, 2> pair{0u, static_cast<uint32_t>(m.particle_count() - 1)};
+  settings.joined_pairs = std::span(&pair, 1);
+  ASSERT_GT(strain_stats(m, s.x).max, 0.19f);
+  const int passes = relax_to_strain_limit(m, s, settings, 10000);
+  EXPECT_GT(passes, 1);
+  EXPECT_LT(passes, 10000);
+  EXPECT_LT(strain_stats(m, s.x).max, threshold + 0.002f);
+  EXPECT_LT((s.x[pair[0]] - s.x[pair[1]]).norm(), 1e-4f);
+  for (size_t i = 0; i < s.v.size(); ++i) EXPECT_EQ(s.v[i], velocities[i]);
+
+  ClothState rest = initial_state(m);
+  const std::vector<Vec3f> before = rest.x;
+  settings.joined_pairs = {};
+  EXPECT_EQ(relax_to_strain_limit(m, rest, settings, 100), 1);
+  EXPECT_EQ(rest.x, before);
 }
 
 TEST(ClothPhysics, TooLargeATimeStepIsReportedNotHidden) {

@@ -50,9 +50,9 @@ struct DressOptions {
   // position-modification passes that pull back what seam holds and contacts stretched.
   int strain_passes = 4;
   int position_passes = 4;
-  // Time step: eq. 4 with each particle's stiffness along its stiffest direction instead of the sum
-  // of its springs' (a bound just as strict, ~1.15-1.35x longer steps; see sewing.cpp). Off by
-  // default: the longer step flips marginal cases (docs/dressing.md, Table 2).
+  // Time step: ClothModel::directional_stable_time_step() instead of stable_time_step() (eq. 4 with
+  // each particle's stiffness along its stiffest direction: just as strict, ~1.15-1.35x longer
+  // steps). Off by default: the longer step flips marginal cases (docs/dressing.md, Table 2).
   bool directional_time_step = false;
   // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
   uint64_t max_iterations = 0;

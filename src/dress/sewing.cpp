@@ -19,9 +19,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <numbers>
-
-#include <Eigen/Core>
 
 #include "drape/dress.hpp"
 
@@ -31,45 +28,6 @@ namespace {
 constexpr int kConvergePasses = 128;  // StepSettings::converge_passes while draping
 constexpr float kRelaxAbove = 0.01f;  // strain over the limit after sewing that is relaxed before draping
 constexpr int kRelaxPasses = 1000;    // at most, Gauss-Seidel position passes (a pass is ~20 us per 1000 springs)
-
-// Eq. 4 with K per particle its stiffness along its stiffest direction (DressOptions::
-// directional_time_step). The spring energy sum_s k_s (u_s . (x_a - x_b))^2 / 2 is at most
-// sum_i x_i^T D_i x_i with D_i = sum of k_s u_s u_s^T over i's springs ((p - q)^2 <= 2 p^2 + 2 q^2),
-// so omega^2 <= max_i 2 lambda_max(D_i) / m_i, and 0.4 pi sqrt(m / lambda_max(D)) keeps eq. 4's
-// margin under symplectic Euler's limit 2 / omega, as ClothModel::stable_time_step() does with
-// K = trace(D) (~1.8x lambda_max for a grid particle, whose springs pull along two axes).
-// Directions are taken on the flat pattern; a spring whose flat length is not its rest length
-// (seams, elastic bands, springs between panels) counts whole in every direction.
-float directional_stable_time_step(const ClothModel& m) {
-  double best = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < m.particle_count(); ++i) {
-    if (m.inverse_mass[i] == 0) continue;
-    Eigen::Matrix2d k_plane = Eigen::Matrix2d::Zero(), c_plane = Eigen::Matrix2d::Zero();
-    double k_iso = 0, c_iso = 0;
-    for (uint32_t e = m.incident_begin[i]; e < m.incident_begin[i + 1]; ++e) {
-      const uint32_t s = m.incident_spring[e];
-      const Eigen::Vector2d d = (m.flat_position[m.spring_b[s]] - m.flat_position[m.spring_a[s]]).cast<double>();
-      const double len = d.norm(), rest = m.rest_length[s];
-      if (rest > 0 && std::abs(len - rest) <= 1e-3 * rest) {
-        const Eigen::Matrix2d uu = d * d.transpose() / (len * len);
-        k_plane += m.stiffness[s] * uu;
-        c_plane += m.damping[s] * uu;
-      } else {
-        k_iso += m.stiffness[s];
-        c_iso += m.damping[s];
-      }
-    }
-    const auto largest = [](const Eigen::Matrix2d& a) {
-      return 0.5 * a.trace() + std::hypot(0.5 * (a(0, 0) - a(1, 1)), a(0, 1));
-    };
-    const double k_max = largest(k_plane) + k_iso, c_max = largest(c_plane) + c_iso;
-    if (k_max <= 0) continue;
-    double dt = 0.4 * std::numbers::pi * std::sqrt(m.mass[i] / k_max);
-    if (c_max > 0) dt = std::min(dt, 0.5 * m.mass[i] / c_max);  // explicit damping: no overshoot
-    best = std::min(best, dt);
-  }
-  return std::isfinite(best) ? static_cast<float>(best) : m.stable_time_step();
-}
 
 // Velocity modification of one zero-length seam spring: no opening, no overshoot.
 inline void limit_seam_velocity(const Vec3f& xa, const Vec3f& xb, Vec3f& va, Vec3f& vb, float wa, float wb, float dt) {
@@ -128,7 +86,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   StepSettings settings = default_step_settings(g.model);
   settings.strain_passes = o.strain_passes;
   settings.position_passes = o.position_passes;
-  const float dt = o.directional_time_step ? directional_stable_time_step(g.model) : g.model.stable_time_step();
+  const float dt = o.directional_time_step ? g.model.directional_stable_time_step() : g.model.stable_time_step();
   settings.time_step = dt;
   g.time_step = dt;
   StepScratch scratch(g.model, std::max<size_t>(colliders.size(), 1));
@@ -168,7 +126,6 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   // garment sewn more than kRelaxAbove over the limit is relaxed to it once, positions only.
   g.sewn_max_strain = strain_stats(g.model, g.state.x).max;
   if (g.sewn_max_strain - settings.strain_threshold > kRelaxAbove) {
-    settings.joined_pairs = held;
     g.relax_passes = relax_to_strain_limit(g.model, g.state, settings, kRelaxPasses);
   }
 

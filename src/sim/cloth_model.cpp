@@ -57,6 +57,45 @@ float ClothModel::stable_time_step() const {
   return std::isfinite(best) ? static_cast<float>(best) : 1e-3f;
 }
 
+// Eq. 4 with K per particle its stiffness along its stiffest direction (DressOptions::
+// directional_time_step). The spring energy sum_s k_s (u_s . (x_a - x_b))^2 / 2 is at most
+// sum_i x_i^T D_i x_i with D_i = sum of k_s u_s u_s^T over i's springs ((p - q)^2 <= 2 p^2 + 2 q^2),
+// so omega^2 <= max_i 2 lambda_max(D_i) / m_i, and 0.4 pi sqrt(m / lambda_max(D)) keeps eq. 4's
+// margin under symplectic Euler's limit 2 / omega, as stable_time_step() does with
+// K = trace(D) (~1.8x lambda_max for a grid particle, whose springs pull along two axes).
+// Directions are taken on the flat pattern; a spring whose flat length is not its rest length
+// (seams, elastic bands, springs between panels) counts whole in every direction.
+float ClothModel::directional_stable_time_step() const {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < particle_count(); ++i) {
+    if (inverse_mass[i] == 0) continue;
+    Eigen::Matrix2d k_plane = Eigen::Matrix2d::Zero(), c_plane = Eigen::Matrix2d::Zero();
+    double k_iso = 0, c_iso = 0;
+    for (uint32_t e = incident_begin[i]; e < incident_begin[i + 1]; ++e) {
+      const uint32_t s = incident_spring[e];
+      const Eigen::Vector2d d = (flat_position[spring_b[s]] - flat_position[spring_a[s]]).cast<double>();
+      const double len = d.norm(), rest = rest_length[s];
+      if (rest > 0 && std::abs(len - rest) <= 1e-3 * rest) {
+        const Eigen::Matrix2d uu = d * d.transpose() / (len * len);
+        k_plane += stiffness[s] * uu;
+        c_plane += damping[s] * uu;
+      } else {
+        k_iso += stiffness[s];
+        c_iso += damping[s];
+      }
+    }
+    const auto largest = [](const Eigen::Matrix2d& a) {
+      return 0.5 * a.trace() + std::hypot(0.5 * (a(0, 0) - a(1, 1)), a(0, 1));
+    };
+    const double k_max = largest(k_plane) + k_iso, c_max = largest(c_plane) + c_iso;
+    if (k_max <= 0) continue;
+    double dt = 0.4 * std::numbers::pi * std::sqrt(mass[i] / k_max);
+    if (c_max > 0) dt = std::min(dt, 0.5 * mass[i] / c_max);  // explicit damping: no overshoot
+    best = std::min(best, dt);
+  }
+  return std::isfinite(best) ? static_cast<float>(best) : stable_time_step();
+}
+
 ClothModel compile(ClothSpec spec) {
   const size_t n = spec.positions.size();
   if (n == 0) throw std::invalid_argument("compile: a cloth needs particles");

@@ -108,19 +108,41 @@ StrainLimitResult limit_strain_velocity(const StepContext& c, bool answer_contac
   });
 }
 
+namespace {
+
+// Done when no spring is over the limit by more than 0.1 % strain (the regular passes' 0.01 %
+// kept the trousers' hips, where contacts push back, at the pass cap: 16 % more time).
+constexpr float kConvergeTolerance = 1e-3f;
+
+// Position modification (Provot) of strain-limited spring s, for run_passes: a correction beyond
+// `tolerance` (a fraction of the rest length) counts.
+auto position_limit(const StepContext& c, float tolerance) {
+  return [&m = c.model, x = c.state.x.data(), stretch = 1.0f + c.settings.strain_threshold, tolerance](size_t s) {
+    const uint32_t a = m.limit_a[s], b = m.limit_b[s];
+    const float rest = m.limit_rest[s];
+    return limit_spring_position(x[a], x[b], m.inverse_mass[a], m.inverse_mass[b], stretch * rest, tolerance * rest)
+               ? Change::Corrected
+               : Change::None;
+  };
+}
+
+// A joined pair brought to its mass-weighted mean position, for run_passes.
+auto position_hold(const StepContext& c) {
+  return [x = c.state.x.data(), w = c.model.inverse_mass.data()](uint32_t a, uint32_t b) {
+    return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance);
+  };
+}
+
+}  // namespace
+
 StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, int converge_passes) {
   const ClothModel& m = c.model;
   Vec3f* x = c.state.x.data();
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold;
-  const auto limit = [&](size_t s) {
-    const uint32_t a = m.limit_a[s], b = m.limit_b[s];
-    const float rest = m.limit_rest[s];
-    return limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kRelativeTolerance * rest) ? Change::Corrected
-                                                                                                 : Change::None;
-  };
-  const auto hold = [&](uint32_t a, uint32_t b) { return hold_pair_position(x[a], x[b], w[a], w[b], kJoinedTolerance); };
-  StrainLimitResult result = run_passes<false>(c, max_passes, limit, hold, [](uint32_t*, uint32_t) {});
+  const auto hold = position_hold(c);
+  StrainLimitResult result =
+      run_passes<false>(c, max_passes, position_limit(c, kRelativeTolerance), hold, [](uint32_t*, uint32_t) {});
   if (!result.at_pass_limit || converge_passes <= 0) return result;
 
   // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, in index
@@ -134,9 +156,6 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   // trembles and the garment does not settle (skirt and trousers S/M/L: 2 of 6 settled without,
   // 5 of 6 with, docs/dressing.md).
   constexpr float kNearLimit = 0.002f;  // strain below the threshold that still joins the set
-  // Done when no spring is over the limit by more than 0.1 % strain (the regular passes' 0.01 %
-  // kept the trousers' hips, where contacts push back, at the pass cap: 16 % more time).
-  constexpr float kConvergeTolerance = 1e-3f;
   constexpr int kRegather = 8;
   uint32_t* active = c.scratch.active_spring.data();
   Vec3f* v = c.state.v.data();
@@ -172,25 +191,12 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
 
 namespace drape {
 
-int relax_to_strain_limit(const ClothModel& m, ClothState& state, const StepSettings& settings, int max_passes) {
-  constexpr float kTolerance = 1e-3f;  // strain over the limit that still counts (converge passes')
-  Vec3f* x = state.x.data();
-  const float* w = m.inverse_mass.data();
-  const float stretch = 1.0f + settings.strain_threshold;
-  int pass = 0;
-  while (pass < max_passes) {
-    ++pass;
-    bool changed = false;
-    for (size_t s = 0; s < m.limit_a.size(); ++s) {
-      const float rest = m.limit_rest[s];
-      changed |= sim::limit_spring_position(x[m.limit_a[s]], x[m.limit_b[s]], w[m.limit_a[s]], w[m.limit_b[s]],
-                                            stretch * rest, kTolerance * rest);
-    }
-    for (const auto& [a, b] : settings.joined_pairs)
-      changed |= sim::hold_pair_position(x[a], x[b], w[a], w[b], sim::kJoinedTolerance);
-    if (!changed) break;
-  }
-  return pass;
+int relax_to_strain_limit(const ClothModel& model, ClothState& state, const StepSettings& settings, int max_passes) {
+  StepScratch unused;  // the position passes keep no per-step scratch (run_passes<false>)
+  const sim::StepContext c{model, state, unused, settings, settings.time_step};
+  return sim::run_passes<false>(c, max_passes, sim::position_limit(c, sim::kConvergeTolerance), sim::position_hold(c),
+                                [](uint32_t*, uint32_t) {})
+      .passes;
 }
 
 }  // namespace drape

@@ -198,6 +198,24 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       h.anchor.y() = rise[p] > 1e-3 ? (target - f.origin.y()) / rise[p] : f.y_top;
       const bool front_back = h.side == PanelSide::front || h.side == PanelSide::back;
       h.anchor.x() = front_back && std::abs(f.across.x()) > 0.1 ? -f.origin.x() / f.across.x() : 0.5 * (f.x_lo + f.x_hi);
+      // A trouser panel's centre front (back) at the waist goes on the midline, as a pattern maker
+      // means it, and its crotch extension crosses it between the legs. A file may lay the panels
+      // out apart (the 2021 pants: crotch points on the midline, waist corners 11 cm off it), and
+      // a seam that starts 22 cm open at the waist stays open there under the band's tension.
+      const bool leg = region == BodyRegion::left_leg || region == BodyRegion::right_leg;
+      if (leg && front_back) {
+        constexpr double kTopBand = 0.01;  // m: vertices this close to the panel's top are its waist
+        double best = std::numeric_limits<double>::max();
+        for (const Vec3f& q : mesh.panels[p].mesh.positions) {
+          const Vec3d d = f.rotation * Vec3d(q.x(), q.y(), 0);
+          if (d.dot(f.up) < f.y_top - kTopBand) continue;
+          const double off_midline = std::abs(f.world(q).x());
+          if (off_midline < best) {
+            best = off_midline;
+            h.anchor.x() = d.dot(f.across);
+          }
+        }
+      }
     }
     any_arm = any_arm || region == BodyRegion::left_arm || region == BodyRegion::right_arm;
     rolled.panels[p].placement = h;

@@ -48,7 +48,6 @@ std::vector<BandFit> gather_elastic_bands(const Body& body, const Garment& garme
   std::vector<uint8_t> band_vertex(spec.positions.size(), 0);
   // Each vertex's seam partner (the first pair that lists it), kNone where it is not sewn.
   constexpr uint32_t kNone = ~uint32_t{0};
-  constexpr double kCrossReach = 6.0;  // a spring may cross a seam that starts this many lengths away
   std::vector<uint32_t> sewn_to(spec.positions.size(), kNone);
   for (const auto& [a, b] : cloth.seam_pairs) {
     if (sewn_to[a] == kNone) sewn_to[a] = b;
@@ -99,23 +98,19 @@ std::vector<BandFit> gather_elastic_bands(const Body& body, const Garment& garme
         const uint32_t a = base + pm.boundary[i], b_own = base + pm.boundary[(i + 1) % nb];
         const double len = (spec.flat_positions[b_own] - spec.flat_positions[a]).cast<double>().norm();
         if (len <= 0) continue;
-        // Where the ring reaches a seam, its spring ends on the sewn vertex of the other panel
-        // when that starts near (the elastic's tension then runs on through the elastic, not
-        // through the corner pair's seam spring, which is weak for light corners and would be
-        // pulled open: a ring broken at a seam pulls the seam's end apart); a far one would make
-        // the spring start stretched many times over.
+        // Where the ring reaches a seam, its spring ends on the sewn vertex of the other panel,
+        // so the elastic's tension runs on through the elastic, not through the corner pair's
+        // seam spring, which is weak for light corners: a ring broken at a seam pulls the seam's
+        // end apart (the flare skirt's corners 45-58 mm, the 2021 pants' outseams 51-55 mm).
+        // Such a spring across a seam that starts open is softer by len / start, so it starts
+        // with no more force than one stretched by its own length (at full stiffness a 12 cm gap
+        // at the pants' outseams sent their corners past the speed limit in the first step).
         uint32_t b = b_own;
         double k = band.stiffness * membrane * band.width / std::max(len, band.width);
         if (sewn_to[b_own] != kNone && sewn_to[b_own] != a) {
-          const double start = (spec.positions[sewn_to[b_own]] - spec.positions[a]).norm();
-          if (start < kCrossReach * len) {
-            b = sewn_to[b_own];
-            // A spring across a seam that starts open is softer by len / start, so it starts with
-            // no more force than one stretched by its own length (stiffer, a 12 cm gap at the
-            // 2021 pants' outseams blew the first sewing step past the speed limit); it closes
-            // the gap with the seam, and the ring is whole from the first step.
-            k *= std::min(1.0, len / std::max(start, len));
-          }
+          b = sewn_to[b_own];
+          const double start = (spec.positions[b] - spec.positions[a]).norm();
+          k *= len / std::max(start, len);
         }
         spec.springs.push_back({a, b, static_cast<float>(scale * len), static_cast<float>(k), kElasticKind});
         band_vertex[a] = band_vertex[b] = band_vertex[b_own] = 1;

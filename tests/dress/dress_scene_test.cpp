@@ -165,13 +165,21 @@ INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
 // - shirt and dress S/M/L on the male body (XL is his cut): a shoulder/armhole corner 10-20 mm open,
 //   the dress's shoulder seams 26-30 mm open at his wider neck;
 // - dress S and M on the female body: marginal, they pass or not with small changes elsewhere
-//   (S once left a shoulder seam 12 mm open, M once still moved at 3 cm/s after 3 s);
+//   (S once left a shoulder seam 12 mm open, M once still moved at 3 cm/s after 3 s; both pass at
+//   a6f396c and both failed with the cloth step's changes in progress at 22:15 UTC);
 // - skirt, trousers and jeans S on the female body (S is drafted for a 0.70 m waist, hers is
 //   0.74 m): skirt and trousers hold the strain at the limit (5.0 %) and keep creeping (not
 //   settled after 3 s); the jeans' outseam top corner stays 14-27 mm open at the hip;
 // - skirt S/M on the male body (waists 0.78/0.82 m, his 0.86 m: L is his size); trousers S/M/L
 //   and jeans S/M/L on the male body (XL is his cut): the band holds an outseam's top corner
 //   15-36 mm open, or the trousers slide off (stayed_on, above_floor), or keep sliding (settled).
+//   At a6f396c: trousers S/M slide off him (0.52 m), L leaves an outseam 17.6 mm open; jeans S/M
+//   leave one 38/36 mm open, L is not settled; skirt L is not settled (S/M: 40/27 mm open).
+// An elastic band on the trousers' four waist edges (docs/garment-format.md, Elastic bands; 22:25
+// UTC, a6f396c) held S on the slim MakeHuman man, but pulled the outseams' top corners 30-63 mm
+// open on the female body in M and L (which pass without it) and did not keep M/L on the default
+// male body (0.48-0.50 m drop): their side edges start 14-16 cm apart, too far for the ring to
+// cross the outseams from the first step, so the built-ins have no band yet.
 class BuiltinNotYet : public BuiltinFit {};
 TEST_P(BuiltinNotYet, DISABLED_PassesTheGates) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
@@ -227,21 +235,28 @@ constexpr const char* kMeanAll = "garmentcode/mean_all.obj";
 constexpr const char* kFemaleAverage = "makehuman/derived/mh_female_average.obj";
 constexpr const char* kFemaleHeavy = "makehuman/derived/mh_female_heavy.obj";
 constexpr const char* kMaleAverage = "makehuman/derived/mh_male_average.obj";
+constexpr const char* kMaleThin = "makehuman/derived/mh_male_thin.obj";
+// The trousers' XS is the men's cut for the slim man (mh_male_thin: waist 0.69 m, hips 0.88 m): a
+// 0.84 m waist 6 cm lower than the women's sizes, so it starts near the hips where it comes to
+// rest (2700 draping iterations, seams 0.01 mm, 5.02 %, drop 0.115 m at 9b044f3..a6f396c). Narrow,
+// like XL: a 0.835 or 0.845 m waist, or the grid 1 mm finer or coarser, is not settled or leaves an
+// outseam's top corner 33 mm open; S (0.87 m) slides off him (0.35 m, then non-finite).
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSize,
                          ::testing::Values(SharedFit{"dress", kMeanAll, "XL"}, SharedFit{"trousers", kMeanAll, "XL"},
                                            SharedFit{"shirt", kFemaleAverage, "S"}, SharedFit{"dress", kFemaleAverage, "S"},
                                            SharedFit{"skirt", kFemaleAverage, "S"}, SharedFit{"jeans", kFemaleAverage, "S"},
                                            SharedFit{"shirt", kFemaleHeavy, "S"}, SharedFit{"dress", kFemaleHeavy, "S"},
                                            SharedFit{"skirt", kFemaleHeavy, "M"}, SharedFit{"trousers", kFemaleHeavy, "M"},
-                                           SharedFit{"skirt", kMaleAverage, "M"}),
+                                           SharedFit{"skirt", kMaleAverage, "M"}, SharedFit{"trousers", kMaleThin, "XS"}),
                          shared_fit_name);
 
-// NOT YET REACHED in the size chosen for the shared body (measured, docs/dressing.md "Status"):
-// shirt XL on mean_all (sewn, 5.0 %, not settled after 3 s; M passes, SharedBody); skirt L on
-// mean_all (not settled); jeans XL on mean_all (an outseam's top corner 16 mm open); trousers S on
-// the average female MakeHuman body (slides down, stayed_on); jeans M on the heavy one (the run
-// went non-finite); trousers on the male MakeHuman bodies (M/S: the smallest trousers' waist,
-// 0.87 m, is far over their 0.69-0.75 m waists: they slide off).
+// NOT YET REACHED in the size chosen for the shared body (measured, docs/dressing.md "Status";
+// re-measured at a6f396c, 22:38 UTC): shirt XL on mean_all (not settled after 3 s; M passes,
+// SharedBody); skirt L on mean_all (not settled); jeans XL on mean_all (an outseam's top corner
+// 16 mm open); trousers S on the average female MakeHuman body (slides 0.165 m, stayed_on); jeans M
+// on the heavy one (non-finite); trousers M on the average male MakeHuman body (waist 0.75 m, hips
+// 0.94 m: M slides 0.20 m; eight men's sizes for him graded like XS, waist 0.84-0.91 m, 4-11 cm
+// lower, hips 1.02-1.05 m, either slid 0.16-0.20 m or left an outseam's top corner 20-42 mm open).
 class SharedBodyOwnSizeNotYet : public SharedBodyOwnSize {};
 TEST_P(SharedBodyOwnSizeNotYet, DISABLED_PassesTheGates) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
@@ -251,8 +266,7 @@ TEST_P(SharedBodyOwnSizeNotYet, DISABLED_PassesTheGates) {
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSizeNotYet,
                          ::testing::Values(SharedFit{"shirt", kMeanAll, "XL"}, SharedFit{"skirt", kMeanAll, "L"},
                                            SharedFit{"jeans", kMeanAll, "XL"}, SharedFit{"trousers", kFemaleAverage, "S"},
-                                           SharedFit{"jeans", kFemaleHeavy, "M"}, SharedFit{"trousers", kMaleAverage, "M"},
-                                           SharedFit{"trousers", "makehuman/derived/mh_male_thin.obj", "S"}),
+                                           SharedFit{"jeans", kFemaleHeavy, "M"}, SharedFit{"trousers", kMaleAverage, "M"}),
                          shared_fit_name);
 
 // The heavy female body (upper arm 0.30 m) wears the shirt's L: in M a sleeve's armhole corner

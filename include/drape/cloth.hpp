@@ -229,10 +229,12 @@ class StepScratch {
   std::vector<Vec3f> spring_force;        // per spring: force on its a end
   std::vector<ContactSample> contact;     // per particle: nearest contact this step
   std::vector<ContactSample> contact_tmp; // per particle: second and later colliders
+  std::vector<float> contact_plane;       // per particle: d(x) = normal . x + plane, its contact's tangent plane
   std::vector<double> block_energy;       // per block: kinetic energy (fixed-order reduction)
   std::vector<float> block_speed;         // per block: max speed squared
   std::vector<uint32_t> block_count;      // per block: counters (contacts, corrections)
   std::vector<uint32_t> active_spring;    // strain-limited springs near the limit (converge passes)
+  std::vector<Vec3f> converge_start;      // per particle: position before the converge passes
   std::vector<uint32_t> changed_in_pass;  // per particle: 1 + the strain pass that last changed it
   size_t max_colliders = 0;
 };

@@ -75,16 +75,28 @@ void ImageCollider::render_maps() {
     cull_front_facing.culling = FaceCulling::kBack;
     rasterize(screen_, reversed_, width_, height_, visibility_, cull_front_facing);
 
-    // Hidden: several layers along the ray, or a surface seen edge-on in either view.
+    // Hidden: several layers along the ray, a surface seen edge-on in either view, or the
+    // silhouette (a covered pixel beside an empty one). At the silhouette the maps cannot answer:
+    // a point just beyond it is over an empty pixel ("no body along this ray") however near the
+    // body's side it is, and one just inside it is judged by a pixel-centre normal that may not be
+    // edge-on enough for the test above. Cloth hanging beside a leg was pushed 4 mm out whenever it
+    // drifted over the silhouette and not seen at all once beside it, and trembled so for ever.
     const float layer_tolerance = 1e-4f;
+    const auto empty = [&](int i, int j) {
+      return i < 0 || j < 0 || i >= width_ || j >= height_ ||
+             front_.triangle[static_cast<size_t>(j) * static_cast<size_t>(width_) + static_cast<size_t>(i)] == kNoTriangle;
+    };
     hidden_.assign(pixels, 0);
-    for (size_t p = 0; p < pixels; ++p) {
-      if (front_.triangle[p] == kNoTriangle) continue;
-      const bool layers = visibility_.covered(p) && -visibility_.depth[p] > back_.depth[p] + layer_tolerance;
-      const bool edge_on = std::abs(front_.normal[p].z()) < options_.edge_on_cosine ||
-                           std::abs(back_.normal[p].z()) < options_.edge_on_cosine;
-      hidden_[p] = layers || edge_on;
-    }
+    for (int j = 0; j < height_; ++j)
+      for (int i = 0; i < width_; ++i) {
+        const size_t p = static_cast<size_t>(j) * static_cast<size_t>(width_) + static_cast<size_t>(i);
+        if (front_.triangle[p] == kNoTriangle) continue;
+        const bool layers = visibility_.covered(p) && -visibility_.depth[p] > back_.depth[p] + layer_tolerance;
+        const bool edge_on = std::abs(front_.normal[p].z()) < options_.edge_on_cosine ||
+                             std::abs(back_.normal[p].z()) < options_.edge_on_cosine;
+        const bool silhouette = empty(i - 1, j) || empty(i + 1, j) || empty(i, j - 1) || empty(i, j + 1);
+        hidden_[p] = layers || edge_on || silhouette;
+      }
     // Grow by kHiddenGrowPixels (a square max filter, rows then columns), also over empty pixels
     // next to the silhouette, where points beside an edge-on wall land.
     dilated_.assign(pixels, 0);

@@ -1,17 +1,27 @@
 // Position update of eq. 3 and the health check that makes a failed simulation say so.
 #include <cmath>
+#include <limits>
 
 #include "sim/parallel.hpp"
 #include "sim/stages.hpp"
 
 namespace drape::sim {
 
+// With velocity-response contacts, each particle's contact is kept as its tangent plane before the
+// particle moves (d(x) = n . x + plane), so the position passes after it can keep the particle out of
+// the body (keep_out_of_contact) without asking the colliders again.
 void integrate_positions(const StepContext& c) {
   Vec3f* x = c.state.x.data();
   const Vec3f* v = c.state.v.data();
+  const ContactSample* contact = c.scratch.contact.data();
+  float* plane = c.scratch.contact_plane.data();
+  const bool planes = c.settings.collision_response == CollisionResponse::Velocity;
   const float dt = c.dt;
   parallel_blocks(c.model.particle_count(), [&](size_t, size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) x[i] += dt * v[i];
+    for (size_t i = begin; i < end; ++i) {
+      plane[i] = planes ? contact[i].distance - contact[i].normal.dot(x[i]) : std::numeric_limits<float>::infinity();
+      x[i] += dt * v[i];
+    }
   });
 }
 

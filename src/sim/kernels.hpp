@@ -80,6 +80,16 @@ inline bool limit_spring_position(Vec3f& xa, Vec3f& xb, float wa, float wb, floa
   return excess > tolerance;
 }
 
+// A particle pulled into a body by a position correction goes back out along its contact's normal,
+// to the thickness layer. The contact is the tangent plane of this step's nearest surface,
+// d(x) = normal . x + plane (plane = +inf: no surface near). Returns true if it moved the particle.
+inline bool keep_out_of_contact(Vec3f& x, const Vec3f& normal, float plane, float thickness) {
+  const float d = normal.dot(x) + plane;
+  if (!(d < thickness)) return false;
+  x += (thickness - d) * normal;
+  return true;
+}
+
 // A joined pair (a sewn seam): both ends get their mass-weighted mean velocity plus the share of
 // -gap/dt that closes the gap at the end of the step (velocity pass), or both move to their
 // mass-weighted mean position (position pass). Momentum is kept. Returns true if it changed

@@ -14,6 +14,7 @@
 //                         position_passes after velocity modification]
 //   check health          NaN / explosion: reported, sticky, never hidden
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 #include "sim/parallel.hpp"
@@ -72,11 +73,13 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   spring_force.assign(model.spring_count(), Vec3f::Zero());
   contact.assign(model.particle_count(), ContactSample{});
   contact_tmp.assign(colliders > 1 ? model.particle_count() : 0, ContactSample{});
+  contact_plane.assign(model.particle_count(), std::numeric_limits<float>::infinity());
   const size_t blocks = sim::block_count(model.particle_count());
   block_energy.assign(blocks, 0.0);
   block_speed.assign(blocks, 0.0f);
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
+  converge_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
   max_colliders = colliders;
 }
@@ -110,6 +113,8 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
   if (state.x.size() != model.particle_count() || state.v.size() != model.particle_count() ||
       scratch.spring_force.size() != model.spring_count() || scratch.contact.size() != model.particle_count() ||
       scratch.changed_in_pass.size() != model.particle_count() ||
+      scratch.contact_plane.size() != model.particle_count() ||
+      scratch.converge_start.size() != model.particle_count() ||
       colliders.size() > std::max<size_t>(scratch.max_colliders, 1) ||
       (colliders.size() > 1 && scratch.contact_tmp.size() != model.particle_count()))
     throw std::invalid_argument("step: state or scratch was not made for this model and collider count");

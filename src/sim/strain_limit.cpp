@@ -114,15 +114,40 @@ namespace {
 // kept the trousers' hips, where contacts push back, at the pass cap: 16 % more time).
 constexpr float kConvergeTolerance = 1e-3f;
 
+// The contacts of this step as seen by the position passes: each particle's tangent plane
+// (StepScratch::contact_plane, written by integrate_positions). A correction that pulls a particle
+// into the body is undone along the normal at once, in the same Gauss-Seidel pass: the contact is
+// one more constraint, solved last. Without it a ring held at the strain limit round a body it
+// barely fits (a skirt's waist on the hips) is pulled into the body by the position passes, pushed
+// out by the next step's response, and pulled in again: the converge passes turned that into
+// velocities of 1-2 m/s at the band and the skirt never settled.
+struct ContactPlanes {
+  const ContactSample* contact = nullptr;  // nullptr: no contacts (relaxation outside a step)
+  const float* plane = nullptr;
+  const float* inverse_mass = nullptr;
+  float thickness = 0;
+  void keep_out(Vec3f* x, uint32_t i) const {
+    if (contact && inverse_mass[i] > 0) keep_out_of_contact(x[i], contact[i].normal, plane[i], thickness);
+  }
+
+};
+ContactPlanes contact_planes(const StepContext& c) {
+  if (c.settings.collision_response != CollisionResponse::Velocity || c.scratch.contact_plane.empty()) return {};
+  return {c.scratch.contact.data(), c.scratch.contact_plane.data(), c.model.inverse_mass.data(),
+          c.model.fabric.collision_thickness};
+}
+
 // Position modification (Provot) of strain-limited spring s, for run_passes: a correction beyond
 // `tolerance` (a fraction of the rest length) counts.
-auto position_limit(const StepContext& c, float tolerance) {
-  return [&m = c.model, x = c.state.x.data(), stretch = 1.0f + c.settings.strain_threshold, tolerance](size_t s) {
+auto position_limit(const StepContext& c, float tolerance, ContactPlanes contacts) {
+  return [&m = c.model, x = c.state.x.data(), stretch = 1.0f + c.settings.strain_threshold, tolerance, contacts](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
-    return limit_spring_position(x[a], x[b], m.inverse_mass[a], m.inverse_mass[b], stretch * rest, tolerance * rest)
-               ? Change::Corrected
-               : Change::None;
+    if (!limit_spring_position(x[a], x[b], m.inverse_mass[a], m.inverse_mass[b], stretch * rest, tolerance * rest))
+      return Change::None;
+    contacts.keep_out(x, a);
+    contacts.keep_out(x, b);
+    return Change::Corrected;
   };
 }
 
@@ -141,26 +166,43 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold;
   const auto hold = position_hold(c);
-  StrainLimitResult result =
-      run_passes<false>(c, max_passes, position_limit(c, kRelativeTolerance), hold, [](uint32_t*, uint32_t) {});
+  const ContactPlanes contacts = contact_planes(c);
+  StrainLimitResult result = run_passes<false>(c, max_passes, position_limit(c, kRelativeTolerance, contacts), hold,
+                                               [](uint32_t*, uint32_t) {});
   if (!result.at_pass_limit || converge_passes <= 0) return result;
 
-  // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, in index
-  // order on one thread (the same result on any number of threads). The set is gathered again every
-  // kRegather passes, since pulling one spring back stretches its neighbours. A ring needs tens of
-  // passes (its widening mode converges at ~(pi/n)^2 per pass), but it is a few hundred springs of
-  // thousands, so this costs a fraction of as many full passes.
-  // Their corrections also go into the velocities (v += dx / dt, as position-based dynamics does):
-  // otherwise the particles keep the velocity that over-stretched the ring, which velocity
-  // modification takes out of a ring only slowly, and move straight back out next step; the band
-  // trembles and the garment does not settle (skirt and trousers S/M/L: 2 of 6 settled without,
-  // 5 of 6 with, docs/dressing.md).
+  // Converge passes: Gauss-Seidel over only the springs within kNearLimit of the limit, on one
+  // thread in a fixed order (the same result on any number of threads). The set is gathered again
+  // every kRegather passes, since pulling one spring back stretches its neighbours. A ring needs tens
+  // of passes (its widening mode converges at ~(pi/n)^2 per pass), but it is a few hundred springs
+  // of thousands, so this costs a fraction of as many full passes.
+  // - The passes sweep the set forwards and backwards in turn (symmetric Gauss-Seidel). Sweeping one
+  //   way only, every pass pulls a ring's particles a little along the ring in the sweep's
+  //   direction; where contacts keep the ring from shrinking (a waist it barely fits) the passes
+  //   never end and the skirt turned about the body a few mm per window, never settling.
+  // - What the passes moved, d = x - x_start, is taken out of the velocities once, at the end: a
+  //   particle moving against d (the way that over-stretched the ring) loses that motion, up to
+  //   |d| / dt. Otherwise it keeps the velocity that over-stretched the ring, which velocity
+  //   modification takes out of a ring only slowly, and moves straight back out next step; the band
+  //   trembles and the garment does not settle. Only taken out, never added (position-based
+  //   dynamics would add d / dt): where contacts keep a ring from shrinking the passes move the
+  //   particles every step, and adding that motion kept the garment moving; taking it out is the
+  //   paper's velocity modification (sec. 3.3) applied to what the passes had to correct, and
+  //   answers a push out of the body inelastically.
   constexpr float kNearLimit = 0.002f;  // strain below the threshold that still joins the set
   constexpr int kRegather = 8;
   uint32_t* active = c.scratch.active_spring.data();
-  Vec3f* v = c.state.v.data();
-  const float inv_dt = 1.0f / c.dt;
+  Vec3f* x_start = c.scratch.converge_start.data();
+  std::copy(x, x + m.particle_count(), x_start);
   size_t count = 0;
+  const auto correct = [&](uint32_t s) {
+    const uint32_t a = m.limit_a[s], b = m.limit_b[s];
+    const float rest = m.limit_rest[s];
+    const bool corrected = limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kConvergeTolerance * rest);
+    contacts.keep_out(x, a);
+    contacts.keep_out(x, b);
+    return corrected ? 1u : 0u;
+  };
   for (int pass = 0; pass < converge_passes; ++pass) {
     if (pass % kRegather == 0) {
       count = 0;
@@ -170,20 +212,32 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
       }
     }
     uint64_t corrections = 0;
-    for (size_t k = 0; k < count; ++k) {
-      const uint32_t a = m.limit_a[active[k]], b = m.limit_b[active[k]];
-      const Vec3f xa = x[a], xb = x[b];
-      const float rest = m.limit_rest[active[k]];
-      corrections += limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kConvergeTolerance * rest) ? 1u : 0u;
-      v[a] += (x[a] - xa) * inv_dt;
-      v[b] += (x[b] - xb) * inv_dt;
+    if (pass % 2 == 0) {
+      for (size_t k = 0; k < count; ++k) corrections += correct(active[k]);
+    } else {
+      for (size_t k = count; k-- > 0;) corrections += correct(active[k]);
     }
-    for (const auto& [a, b] : c.settings.joined_pairs) corrections += hold(a, b) ? 1u : 0u;
+    for (const auto& [a, b] : c.settings.joined_pairs) {
+      if (!hold(a, b)) continue;
+      ++corrections;
+      contacts.keep_out(x, a);
+      contacts.keep_out(x, b);
+    }
     ++result.passes;
     result.corrections += corrections;
     result.at_pass_limit = corrections > 0;
     if (corrections == 0) break;
   }
+  Vec3f* v = c.state.v.data();
+  const float inv_dt = 1.0f / c.dt;
+  parallel_blocks(m.particle_count(), [&](size_t, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      if (x[i] == x_start[i]) continue;
+      const Vec3f d = x[i] - x_start[i];
+      const float along = v[i].dot(d), d2 = d.squaredNorm();  // < 0: moving against the correction
+      if (along < 0) v[i] += std::min(inv_dt, -along / d2) * d;
+    }
+  });
   return result;
 }
 
@@ -194,7 +248,7 @@ namespace drape {
 int relax_to_strain_limit(const ClothModel& model, ClothState& state, const StepSettings& settings, int max_passes) {
   StepScratch unused;  // the position passes keep no per-step scratch (run_passes<false>)
   const sim::StepContext c{model, state, unused, settings, settings.time_step};
-  return sim::run_passes<false>(c, max_passes, sim::position_limit(c, sim::kConvergeTolerance), sim::position_hold(c),
+  return sim::run_passes<false>(c, max_passes, sim::position_limit(c, sim::kConvergeTolerance, {}), sim::position_hold(c),
                                 [](uint32_t*, uint32_t) {})
       .passes;
 }

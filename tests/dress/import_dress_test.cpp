@@ -339,7 +339,8 @@ TEST_P(Template2021, PassesTheGatesOnASlimBody) {
 INSTANTIATE_TEST_SUITE_P(Skirt, Template2021, ::testing::Values("garment_pattern_generator_2021/skirt_4_panels.json"),
                          pattern_case_name);
 
-// NOT YET REACHED (measured 22:30 UTC on the same body, `drape dress --measurements
+// NOT YET REACHED before main 0e1e0b8 (the trousers pass since, see Trousers below; measured
+// 22:30 UTC on the same body, `drape dress --measurements
 // height=1.70,bust=0.82,waist=0.66,hips=0.90 --garment FILE`): the trousers' waist (0.80 m, no
 // darts, the seat 1.20 m round) is imported as an elastic band (relaxed 0.63 m, the body's waist
 // less 5 %): they stay up (drop 0.056-0.060 m) and every seam closes while sewing (1186-1221
@@ -353,9 +354,15 @@ INSTANTIATE_TEST_SUITE_P(Skirt, Template2021, ::testing::Values("garment_pattern
 // The tee on this A-posed body: shoulder seams 90 mm open (its sleeves are laid out for a
 // T-pose), see below.
 INSTANTIATE_TEST_SUITE_P(DISABLED_TeeAndTrousers, Template2021,
-                         ::testing::Values("garment_pattern_generator_2021/tee.json",
-                                           "garment_pattern_generator_2021/pants_straight_sides.json"),
-                         pattern_case_name);
+                         ::testing::Values("garment_pattern_generator_2021/tee.json"), pattern_case_name);
+
+// The trousers pass every gate since the cloth step solves contacts inside its position passes
+// (main 0e1e0b8, measured 23:15 UTC, the same with 1 or 2 threads): sewn in 1227 iterations, seams
+// 0.01 mm, strain 5.05 % (limit 6 %), 0 inside, settled (report.json final_max_speed 0.15 m/s; the
+// hem corners trembled at up to 1.8 m/s before), drop 0.059 m. At the default grid only: with
+// --edge 0.022/0.025/0.027 a seam still stays 21/13/13 mm open (settled, 5.0 %).
+INSTANTIATE_TEST_SUITE_P(Trousers, Template2021,
+                         ::testing::Values("garment_pattern_generator_2021/pants_straight_sides.json"), pattern_case_name);
 
 // The elastic waist holds the trousers up by its tension alone (nothing pinned): after two seconds
 // of draping on the slim body they have dropped a few centimetres with their band and are falling

@@ -140,8 +140,8 @@ std::string builtin_case_name(const ::testing::TestParamInfo<BuiltinCase>& info)
 
 // NOT YET REACHED as a whole (DISABLED_ prefix on the suite: run with
 // --gtest_also_run_disabled_tests). The passing garment/size/body cases of these suites are
-// asserted in dress_scene_test.cpp (BuiltinFit: dress L, jeans and trousers M/L on the female
-// body, jeans and trousers XL on the male body) and the others are listed there (BuiltinNotYet)
+// asserted in dress_scene_test.cpp (BuiltinFit: dress S/M/L, jeans and trousers M/L on the female
+// body, jeans L/XL and trousers XL on the male body) and the others are listed there (BuiltinNotYet)
 // with their current figures (22:38 UTC, a6f396c). History, measured at 14:51 UTC on main:
 // trousers on the female body close every seam but are stretched 10-18 % on the hips (wool: 6 %);
 // with the sewing settings in the working tree at 14:44 (not committed) they passed in S, M and L

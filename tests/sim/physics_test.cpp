@@ -106,23 +106,28 @@ TEST(ClothPhysics, EnergyDoesNotGrowWithoutExternalForces) {
   EXPECT_LT(previous, 0.5 * e0);
 }
 
+// A horizontal ring of n cotton particles of 1 g at height 1 m, `radius` round the Y axis, joined by
+// structural springs of rest length `rest` (a waistband).
+ClothModel cotton_ring(uint32_t n, float radius, float rest) {
+  ClothSpec spec;
+  spec.fabric = fabric_or_throw("cotton");
+  for (uint32_t i = 0; i < n; ++i) {
+    const float angle = 2.0f * 3.14159265f * static_cast<float>(i) / static_cast<float>(n);
+    spec.positions.emplace_back(radius * std::cos(angle), 1.0f, radius * std::sin(angle));
+    spec.mass.push_back(0.001f);
+    spec.drag_area.push_back(0.0f);
+    spec.springs.push_back({i, (i + 1) % n, rest, 10.0f, SpringKind::Structural});
+  }
+  return compile(std::move(spec));
+}
+
 // A ring of n particles whose structural springs are all 10 % too long (a waistband pulled wide):
 // the regular Gauss-Seidel passes shrink it only at ~(pi/n)^2 per pass, the converge passes over the
 // springs still near the limit bring every spring back to the threshold.
 TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
   constexpr uint32_t n = 24;
   constexpr float rest = 0.02f, threshold = 0.05f;
-  ClothSpec spec;
-  spec.fabric = fabric_or_throw("cotton");
-  const float radius = 1.10f * rest / (2.0f * std::sin(3.14159265f / n));
-  for (uint32_t i = 0; i < n; ++i) {
-    const float angle = 2.0f * 3.14159265f * static_cast<float>(i) / n;
-    spec.positions.emplace_back(radius * std::cos(angle), 1.0f, radius * std::sin(angle));
-    spec.mass.push_back(0.001f);
-    spec.drag_area.push_back(0.0f);
-    spec.springs.push_back({i, (i + 1) % n, rest, 10.0f, SpringKind::Structural});
-  }
-  const ClothModel model = compile(std::move(spec));
+  const ClothModel model = cotton_ring(n, 1.10f * rest / (2.0f * std::sin(3.14159265f / n)), rest);
   const auto ring_strain = [&](int converge_passes) {
     ClothState state = initial_state(model);
     // The ring is still being pulled wide, at 0.5 m/s outwards.
@@ -154,18 +159,9 @@ TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
 TEST(ClothPhysics, RingTooSmallForAPostComesToRestOnIt) {
   constexpr uint32_t n = 24;
   constexpr float threshold = 0.05f, post_radius = 0.07f;
-  ClothSpec spec;
-  spec.fabric = fabric_or_throw("cotton");
-  const float touching = post_radius + spec.fabric.collision_thickness;
+  const float touching = post_radius + fabric_or_throw("cotton").collision_thickness;
   const float rest = 2.0f * touching * std::sin(3.14159265f / n) / ((1.0f + threshold) * 1.005f);
-  for (uint32_t i = 0; i < n; ++i) {
-    const float angle = 2.0f * 3.14159265f * static_cast<float>(i) / n;
-    spec.positions.emplace_back(touching * std::cos(angle), 1.0f, touching * std::sin(angle));
-    spec.mass.push_back(0.001f);
-    spec.drag_area.push_back(0.0f);
-    spec.springs.push_back({i, (i + 1) % n, rest, 10.0f, SpringKind::Structural});
-  }
-  const ClothModel model = compile(std::move(spec));
+  const ClothModel model = cotton_ring(n, touching, rest);
   CapsuleCollider post(Vec3f(0, 0, 0), Vec3f(0, 2, 0), post_radius);
   Collider* colliders[] = {&post};
   ClothState state = initial_state(model);

@@ -129,7 +129,6 @@ struct ContactPlanes {
   void keep_out(Vec3f* x, uint32_t i) const {
     if (contact && inverse_mass[i] > 0) keep_out_of_contact(x[i], contact[i].normal, plane[i], thickness);
   }
-
 };
 ContactPlanes contact_planes(const StepContext& c) {
   if (c.settings.collision_response != CollisionResponse::Velocity || c.scratch.contact_plane.empty()) return {};

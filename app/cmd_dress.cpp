@@ -29,6 +29,7 @@ struct DressArgs {
   double edge = kPaperEdgeLength;
   int threads = 0;
   uint64_t max_iterations = 0;
+  float mass_scaling = DressOptions{}.mass_scaling;
   bool placement_only = false;
   std::string out = "out";
   LoadOptions load;
@@ -56,6 +57,9 @@ void run_dress(const DressArgs& a) {
   o.mesh.edge_length = a.edge;
   if (!a.fabric.empty()) o.fabric = fabric_or_throw(a.fabric).name;
   o.max_iterations = a.max_iterations;
+  if (!(a.mass_scaling >= 0 && a.mass_scaling <= 1))
+    throw InputError("--mass-scaling", "must be in [0, 1] (a fraction of the median particle's time step; 0: off)");
+  o.mass_scaling = a.mass_scaling;
   o.simulate = !a.placement_only;
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
@@ -128,6 +132,10 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->check(CLI::Range(0, 1024));
   cmd->add_option("--max-iterations", args->max_iterations,
                   "stop each garment after this many iterations (0: no cap); a capped run fails the settled gate");
+  cmd->add_option("--mass-scaling", args->mass_scaling,
+                  "particles whose stability bound is below this fraction of the median particle's get more inertia "
+                  "(weight unchanged), for a longer time step; the state of rest is the same (0: off)")
+      ->capture_default_str();
   cmd->add_flag("--placement-only", args->placement_only,
                 "write the garments where placement put them, before sewing (fails the settled gate)");
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();

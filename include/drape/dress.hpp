@@ -56,6 +56,11 @@ struct DressOptions {
   // each particle's stiffness along its stiffest direction: just as strict, ~1.15-1.35x longer
   // steps). Off by default: the longer step flips marginal cases (docs/dressing.md, Table 2).
   bool directional_time_step = false;
+  // Selective mass scaling (scale_inertia(), docs/cloth.md): particles whose own stability bound is
+  // below `mass_scaling` x the median particle's move as heavier particles (their weight unchanged),
+  // so the step is set by the median particle, not by slivers of cells at the outline. Draping looks
+  // for the state of rest, which does not depend on the inertia. 0: off.
+  float mass_scaling = 0.85f;
   // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
   uint64_t max_iterations = 0;
   // false: stop after placement (to inspect where the panels start); the run is not settled.
@@ -88,6 +93,7 @@ struct DressedGarment {
   uint64_t sewing_iterations = 0, drape_iterations = 0;
   float sewn_max_strain = 0;   // structural strain when sewing ended (the seams may pull past the limit)
   int relax_passes = 0;        // position passes that relaxed the sewn garment to the strain limit (0: none needed)
+  size_t mass_scaled = 0;      // particles given more inertia by DressOptions::mass_scaling
   double sewing_seconds = 0, drape_seconds = 0;  // wall
   bool seams_closed = false, settled = false;
   StepStatus status = StepStatus::Ok;

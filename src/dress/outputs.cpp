@@ -86,6 +86,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"final_max_speed_m_per_s", g.state.max_speed},
                         {"final_rms_speed_m_per_s", std::sqrt(2.0 * g.state.kinetic_energy / g.model.total_mass())},
                         {"time_step_s", g.time_step},
+                        {"mass_scaled_particles", g.mass_scaled},
                         {"centre_drop_m", g.drop_m},
                         {"strain_threshold", g.model.fabric.strain_threshold},
                         {"panels", panels},
@@ -102,6 +103,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                        {"settle_distance_m", o.settle_distance_m},
                        {"settle_window_s", o.settle_window_s},
                        {"max_iterations", o.max_iterations},
+                       {"mass_scaling", o.mass_scaling},
                        {"penetration_tolerance_m", kPenetrationTolerance}};
   extra["setup_seconds"] = r.setup_seconds;
   return report_json(r.quality, r.simulation, r.gates, extra.dump());

@@ -49,9 +49,10 @@ float ClothModel::stable_time_step() const {
       c_sum += damping[incident_spring[e]];
     }
     if (k_sum <= 0) continue;
-    double dt = 0.4 * std::numbers::pi * std::sqrt(mass[i] / k_sum);
+    const double m = inertial_mass(i);
+    double dt = 0.4 * std::numbers::pi * std::sqrt(m / k_sum);
     // Explicit damping must not overshoot: c dt / m well below 1.
-    if (c_sum > 0) dt = std::min(dt, 0.5 * mass[i] / c_sum);
+    if (c_sum > 0) dt = std::min(dt, 0.5 * m / c_sum);
     best = std::min(best, dt);
   }
   return std::isfinite(best) ? static_cast<float>(best) : 1e-3f;
@@ -89,11 +90,47 @@ float ClothModel::directional_stable_time_step() const {
     };
     const double k_max = largest(k_plane) + k_iso, c_max = largest(c_plane) + c_iso;
     if (k_max <= 0) continue;
-    double dt = 0.4 * std::numbers::pi * std::sqrt(mass[i] / k_max);
-    if (c_max > 0) dt = std::min(dt, 0.5 * mass[i] / c_max);  // explicit damping: no overshoot
+    const double m = inertial_mass(i);
+    double dt = 0.4 * std::numbers::pi * std::sqrt(m / k_max);
+    if (c_max > 0) dt = std::min(dt, 0.5 * m / c_max);  // explicit damping: no overshoot
     best = std::min(best, dt);
   }
   return std::isfinite(best) ? static_cast<float>(best) : stable_time_step();
+}
+
+size_t scale_inertia(ClothModel& model, float ratio) {
+  if (!(ratio > 0)) return 0;
+  const size_t n = model.particle_count();
+  // Each free particle's own bound, as stable_time_step() takes it: 0.4 pi sqrt(m / K) and 0.5 m / C.
+  std::vector<double> stiffness_dt(n, 0.0), damping_dt(n, 0.0), bound;
+  bound.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    if (model.inverse_mass[i] == 0) continue;
+    double k_sum = 0, c_sum = 0;
+    for (uint32_t e = model.incident_begin[i]; e < model.incident_begin[i + 1]; ++e) {
+      k_sum += model.stiffness[model.incident_spring[e]];
+      c_sum += model.damping[model.incident_spring[e]];
+    }
+    const double m = model.inertial_mass(i);
+    stiffness_dt[i] = k_sum > 0 ? 0.4 * std::numbers::pi * std::sqrt(m / k_sum) : std::numeric_limits<double>::infinity();
+    damping_dt[i] = c_sum > 0 ? 0.5 * m / c_sum : std::numeric_limits<double>::infinity();
+    bound.push_back(std::min(stiffness_dt[i], damping_dt[i]));
+  }
+  if (bound.empty()) return 0;
+  std::nth_element(bound.begin(), bound.begin() + static_cast<std::ptrdiff_t>(bound.size() / 2), bound.end());
+  const double target = ratio * bound[bound.size() / 2];
+  if (!std::isfinite(target)) return 0;
+  if (model.inertia_scale.empty()) model.inertia_scale.assign(n, 1.0f);
+  size_t scaled = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (model.inverse_mass[i] == 0 || std::min(stiffness_dt[i], damping_dt[i]) >= target) continue;
+    // The stiffness term grows as sqrt(scale), the damping term as scale.
+    const double s = std::max({1.0, (target / stiffness_dt[i]) * (target / stiffness_dt[i]), target / damping_dt[i]});
+    model.inertia_scale[i] = static_cast<float>(model.inertia_scale[i] * s);
+    model.inverse_mass[i] = 1.0f / model.inertial_mass(i);
+    ++scaled;
+  }
+  return scaled;
 }
 
 ClothModel compile(ClothSpec spec) {

@@ -28,7 +28,8 @@ void compute_spring_forces(const StepContext& c) {
 }
 
 // Sum of forces on each particle -> acceleration -> v(t + dt) = v(t) + dt a (eq. 3).
-// External forces: gravity, viscous damping -gamma m v (sec. 2.2), quadratic air drag.
+// External forces: gravity, viscous damping -gamma m v (sec. 2.2; m the inertial mass, so the damping
+// rate gamma is the same for every particle), quadratic air drag.
 void integrate_velocities(const StepContext& c) {
   const ClothModel& m = c.model;
   const Vec3f* force = c.scratch.spring_force.data();
@@ -38,6 +39,7 @@ void integrate_velocities(const StepContext& c) {
   const float* sign = m.incident_sign.data();
   const float* inv_mass = m.inverse_mass.data();
   const float* area = m.drag_area.data();
+  const float* inertia = m.inertia_scale.empty() ? nullptr : m.inertia_scale.data();
   const Vec3f g = c.settings.gravity;
   const float dt = c.dt, drag = m.fabric.air_drag;
   const float gamma = c.settings.air_damping >= 0 ? c.settings.air_damping : m.fabric.air_damping;
@@ -48,7 +50,9 @@ void integrate_velocities(const StepContext& c) {
       const Vec3f vi = v[i];
       f -= (drag * area[i] * vi.norm()) * vi;
       const float live = inv_mass[i] > 0 ? 1.0f : 0.0f;
-      const Vec3f a = inv_mass[i] * f + live * (g - gamma * vi);
+      // Weight m g on an inertial mass s m (scale_inertia()): g / s.
+      const Vec3f gi = inertia ? Vec3f(g / inertia[i]) : g;
+      const Vec3f a = inv_mass[i] * f + live * (gi - gamma * vi);
       v[i] = vi + dt * a;
     }
   });

@@ -15,11 +15,13 @@ void integrate_positions(const StepContext& c) {
   const Vec3f* v = c.state.v.data();
   const ContactSample* contact = c.scratch.contact.data();
   float* plane = c.scratch.contact_plane.data();
+  Vec3f* start = c.scratch.step_start.data();
   const bool planes = c.settings.collision_response == CollisionResponse::Velocity;
   const float dt = c.dt;
   parallel_blocks(c.model.particle_count(), [&](size_t, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       plane[i] = planes ? contact[i].distance - contact[i].normal.dot(x[i]) : std::numeric_limits<float>::infinity();
+      start[i] = x[i];
       x[i] += dt * v[i];
     }
   });

@@ -82,11 +82,24 @@ inline bool limit_spring_position(Vec3f& xa, Vec3f& xb, float wa, float wb, floa
 
 // A particle pulled into a body by a position correction goes back out along its contact's normal,
 // to the thickness layer. The contact is the tangent plane of this step's nearest surface,
-// d(x) = normal . x + plane (plane = +inf: no surface near). Returns true if it moved the particle.
-inline bool keep_out_of_contact(Vec3f& x, const Vec3f& normal, float plane, float thickness) {
+// d(x) = normal . x + plane (plane = +inf: no surface near). Coulomb friction at the position level
+// (as position-based dynamics does it): the push out, p, takes up to friction x p off the particle's
+// sliding along the surface since the start of the step (x - start, tangential part). Without it a
+// band held on the hips by the position passes pressed on the body with no friction to show for it,
+// and how much of its grip was velocity response (with friction) or position pass (without)
+// depended on the time step. Returns true if it moved the particle.
+inline bool keep_out_of_contact(Vec3f& x, const Vec3f& normal, float plane, float thickness, const Vec3f& start,
+                                float friction) {
   const float d = normal.dot(x) + plane;
   if (!(d < thickness)) return false;
-  x += (thickness - d) * normal;
+  const float push = thickness - d;
+  x += push * normal;
+  if (friction > 0) {
+    const Vec3f moved = x - start;
+    const Vec3f slide = moved - normal.dot(moved) * normal;
+    const float length = slide.norm();
+    if (length > 0) x -= std::min(1.0f, friction * push / length) * slide;
+  }
   return true;
 }
 

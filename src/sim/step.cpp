@@ -80,6 +80,7 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
   converge_start.assign(model.particle_count(), Vec3f::Zero());
+  step_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
   max_colliders = colliders;
 }
@@ -115,6 +116,7 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.changed_in_pass.size() != model.particle_count() ||
       scratch.contact_plane.size() != model.particle_count() ||
       scratch.converge_start.size() != model.particle_count() ||
+      scratch.step_start.size() != model.particle_count() ||
       colliders.size() > std::max<size_t>(scratch.max_colliders, 1) ||
       (colliders.size() > 1 && scratch.contact_tmp.size() != model.particle_count()))
     throw std::invalid_argument("step: state or scratch was not made for this model and collider count");

@@ -125,15 +125,18 @@ struct ContactPlanes {
   const ContactSample* contact = nullptr;  // nullptr: no contacts (relaxation outside a step)
   const float* plane = nullptr;
   const float* inverse_mass = nullptr;
-  float thickness = 0;
+  const Vec3f* start = nullptr;  // position before the step's position update
+  float thickness = 0, friction = 0;
   void keep_out(Vec3f* x, uint32_t i) const {
-    if (contact && inverse_mass[i] > 0) keep_out_of_contact(x[i], contact[i].normal, plane[i], thickness);
+    if (contact && inverse_mass[i] > 0)
+      keep_out_of_contact(x[i], contact[i].normal, plane[i], thickness, start[i], friction);
   }
 };
 ContactPlanes contact_planes(const StepContext& c) {
   if (c.settings.collision_response != CollisionResponse::Velocity || c.scratch.contact_plane.empty()) return {};
   return {c.scratch.contact.data(), c.scratch.contact_plane.data(), c.model.inverse_mass.data(),
-          c.model.fabric.collision_thickness};
+          c.scratch.step_start.data(), c.model.fabric.collision_thickness,
+          c.settings.friction >= 0 ? c.settings.friction : c.model.fabric.friction};
 }
 
 // Position modification (Provot) of strain-limited spring s, for run_passes: a correction beyond

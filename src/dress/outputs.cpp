@@ -87,6 +87,10 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"final_rms_speed_m_per_s", std::sqrt(2.0 * g.state.kinetic_energy / g.model.total_mass())},
                         {"time_step_s", g.time_step},
                         {"mass_scaled_particles", g.mass_scaled},
+                        // Gauss-Seidel passes per step (velocity, position and converge passes) and the
+                        // steps whose last pass still corrected springs (the passes' cost: docs/cloth.md).
+                        {"strain_passes_per_iteration", g.profile.steps ? double(g.profile.strain_passes) / double(g.profile.steps) : 0.0},
+                        {"iterations_at_pass_limit", g.profile.steps_at_pass_limit},
                         {"centre_drop_m", g.drop_m},
                         {"strain_threshold", g.model.fabric.strain_threshold},
                         {"panels", panels},

@@ -45,6 +45,9 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
     EXPECT_TRUE(report["simulation"].contains(k)) << k;
   EXPECT_EQ(report["gates"]["passed"].get<bool>(), r.exit_code == 0);
   EXPECT_EQ(report["garments"][0]["name"], "shirt");
+  // Draping with selective mass scaling (on by default): the outline's light particles were scaled.
+  EXPECT_GT(report["garments"][0]["mass_scaled_particles"].get<int>(), 0);
+  EXPECT_GT(report["garments"][0]["strain_passes_per_iteration"].get<double>(), 0.0);
   EXPECT_TRUE(test::gltf_is_valid(dir / "dressed.glb"));
 }
 
@@ -68,8 +71,12 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
   r = test::run_drape("dress --body " + (dir / "missing.obj").string() + " --out " + (dir / "b").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("missing.obj"), std::string::npos) << r.err;
+  r = test::run_drape("dress --mass-scaling 2 --out " + (dir / "c").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--mass-scaling"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "a"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "c"));
 }
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {

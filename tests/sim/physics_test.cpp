@@ -277,6 +277,48 @@ TEST(ClothPhysics, PinnedParticlesStayWhereTheyAre) {
   EXPECT_LT(s.x[55].y(), m.rest_position[55].y() - 0.05f);  // the rest hangs down
 }
 
+// Selective mass scaling (scale_inertia): the light particles at the edges and corners of a grid
+// get more inertia, so the stable step is longer; their weight is unchanged, so a curtain hanging
+// from its top row comes to rest in the same shape as the unscaled one. The curtain hangs without a
+// strain limit, so its shape is set by its weight against its springs (~2 % strain at the top).
+TEST(ClothPhysics, MassScalingLengthensTheStepAndKeepsTheStateOfRest) {
+  ClothSpec spec = grid_cloth_spec(fabric_or_throw("cotton"), GridClothOptions{.nx = 12, .ny = 12, .width = 0.3f, .height = 0.3f});
+  spec.pinned.assign(spec.positions.size(), 0);
+  for (uint32_t i = 0; i < 12; ++i) spec.pinned[i] = 1;  // the first row (iy = 0)
+  const ClothModel plain = compile(std::move(spec));
+  ClothModel scaled = plain;
+  const size_t count = scale_inertia(scaled, 1.0f);
+  EXPECT_GT(count, 0u);
+  EXPECT_LT(count, plain.particle_count() / 2 + 1);  // at most the particles below the median
+  EXPECT_GT(scaled.stable_time_step(), 1.2f * plain.stable_time_step());  // 1.27x: the corners set it
+  EXPECT_EQ(scaled.mass, plain.mass);  // the weights
+  EXPECT_EQ(scale_inertia(scaled, 0.0f), 0u);
+  for (size_t i = 0; i < 12; ++i) EXPECT_EQ(scaled.inverse_mass[i], 0.0f);  // pinned stay pinned
+  // Every particle below 2x the median's step scaled (most of them, by up to ~4x): a wrong weight
+  // would show.
+  ClothModel heavy = plain;
+  EXPECT_GT(scale_inertia(heavy, 2.0f), plain.particle_count() / 2);
+  const auto hang = [](const ClothModel& m) {
+    ClothState s = initial_state(m);
+    StepSettings settings = default_step_settings(m);
+    settings.strain_limit = StrainLimit::None;
+    settings.air_damping = 10.0f;
+    settings.time_step = m.stable_time_step();
+    StepScratch scratch(m);
+    while (s.time < 10.0) EXPECT_EQ(step(m, s, {}, settings, scratch), StepStatus::Ok);
+    EXPECT_LT(s.max_speed, 1e-3f);
+    return s;
+  };
+  const ClothState a = hang(plain);
+  for (const ClothModel* m : {&scaled, &heavy}) {
+    const ClothState b = hang(*m);
+    float largest = 0;
+    for (size_t i = 0; i < a.x.size(); ++i) largest = std::max(largest, (a.x[i] - b.x[i]).norm());
+    EXPECT_LT(largest, 1e-3f) << "the scaled curtain came to rest elsewhere";
+  }
+  EXPECT_LT(a.x[12 * 11].y(), plain.rest_position[12 * 11].y() - 0.2f);  // it does hang down
+}
+
 TEST(ClothPhysics, ForceResponseHoldsTheClothAboveAMovingFloor) {
   // Sec. 5: a floor rising at 0.2 m/s under a resting cloth carries it up without letting it through.
   const ClothModel m = test_grid(10);

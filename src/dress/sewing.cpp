@@ -132,8 +132,8 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
 
   // Draping looks for the state of rest, which does not depend on the inertia: light particles at the
   // outline get more (DressOptions::mass_scaling), for a longer step. Not while sewing: the seams run
-  // along the outline, and heavier seam particles closed too slowly (the 2021 pants and trousers XL
-  // on the default male body kept a seam 15-20 mm open after 1.5 s).
+  // along the outline, and heavier seam particles closed too slowly (in a trial build that scaled
+  // them, the 2021 pants and trousers XL on the default male body kept a seam 15-20 mm open after 1.5 s).
   g.mass_scaled = scale_inertia(g.model, o.mass_scaling);
   dt = stable_step();
   settings.time_step = dt;

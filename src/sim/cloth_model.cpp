@@ -36,24 +36,37 @@ float ClothModel::total_mass() const {
   return static_cast<float>(sum);
 }
 
-// Eq. 4, dt <= 0.4 pi sqrt(m / K). K is taken per particle as the sum of the stiffnesses of its
-// springs: by Gershgorin the highest squared frequency is at most 2 K / m, and symplectic Euler is
-// stable for dt < 2 / omega = sqrt(2 m / K), which 0.4 pi sqrt(m / K) respects (1.257 < 1.414).
+namespace {
+
+// One free particle's own bounds on the step (infinite where it has no such springs): eq. 4,
+// dt <= 0.4 pi sqrt(m / K), with K the sum of the stiffnesses of its springs (by Gershgorin the
+// highest squared frequency is at most 2 K / m, and symplectic Euler is stable for dt < 2 / omega =
+// sqrt(2 m / K), which 0.4 pi sqrt(m / K) respects: 1.257 < 1.414), and, so that explicit damping
+// does not overshoot (c dt / m well below 1), dt <= 0.5 m / C with C the sum of its spring dampings.
+// m is the inertial mass.
+struct ParticleBound {
+  double stiffness, damping;
+  double step() const { return std::min(stiffness, damping); }
+};
+ParticleBound particle_bound(const ClothModel& model, size_t i) {
+  double k_sum = 0, c_sum = 0;
+  for (uint32_t e = model.incident_begin[i]; e < model.incident_begin[i + 1]; ++e) {
+    k_sum += model.stiffness[model.incident_spring[e]];
+    c_sum += model.damping[model.incident_spring[e]];
+  }
+  const double m = model.inertial_mass(i), none = std::numeric_limits<double>::infinity();
+  return {k_sum > 0 ? 0.4 * std::numbers::pi * std::sqrt(m / k_sum) : none, c_sum > 0 ? 0.5 * m / c_sum : none};
+}
+
+}  // namespace
+
+// The smallest particle bound; particles without springs (or pinned) do not count.
 float ClothModel::stable_time_step() const {
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < mass.size(); ++i) {
     if (inverse_mass[i] == 0) continue;
-    double k_sum = 0, c_sum = 0;
-    for (uint32_t e = incident_begin[i]; e < incident_begin[i + 1]; ++e) {
-      k_sum += stiffness[incident_spring[e]];
-      c_sum += damping[incident_spring[e]];
-    }
-    if (k_sum <= 0) continue;
-    const double m = inertial_mass(i);
-    double dt = 0.4 * std::numbers::pi * std::sqrt(m / k_sum);
-    // Explicit damping must not overshoot: c dt / m well below 1.
-    if (c_sum > 0) dt = std::min(dt, 0.5 * m / c_sum);
-    best = std::min(best, dt);
+    const ParticleBound bound = particle_bound(*this, i);
+    if (std::isfinite(bound.stiffness)) best = std::min(best, bound.step());
   }
   return std::isfinite(best) ? static_cast<float>(best) : 1e-3f;
 }
@@ -101,31 +114,25 @@ float ClothModel::directional_stable_time_step() const {
 size_t scale_inertia(ClothModel& model, float ratio) {
   if (!(ratio > 0)) return 0;
   const size_t n = model.particle_count();
-  // Each free particle's own bound, as stable_time_step() takes it: 0.4 pi sqrt(m / K) and 0.5 m / C.
-  std::vector<double> stiffness_dt(n, 0.0), damping_dt(n, 0.0), bound;
-  bound.reserve(n);
+  std::vector<ParticleBound> bounds(n);
+  std::vector<double> steps;  // of the free particles, for the median
+  steps.reserve(n);
   for (size_t i = 0; i < n; ++i) {
     if (model.inverse_mass[i] == 0) continue;
-    double k_sum = 0, c_sum = 0;
-    for (uint32_t e = model.incident_begin[i]; e < model.incident_begin[i + 1]; ++e) {
-      k_sum += model.stiffness[model.incident_spring[e]];
-      c_sum += model.damping[model.incident_spring[e]];
-    }
-    const double m = model.inertial_mass(i);
-    stiffness_dt[i] = k_sum > 0 ? 0.4 * std::numbers::pi * std::sqrt(m / k_sum) : std::numeric_limits<double>::infinity();
-    damping_dt[i] = c_sum > 0 ? 0.5 * m / c_sum : std::numeric_limits<double>::infinity();
-    bound.push_back(std::min(stiffness_dt[i], damping_dt[i]));
+    bounds[i] = particle_bound(model, i);
+    steps.push_back(bounds[i].step());
   }
-  if (bound.empty()) return 0;
-  std::nth_element(bound.begin(), bound.begin() + static_cast<std::ptrdiff_t>(bound.size() / 2), bound.end());
-  const double target = ratio * bound[bound.size() / 2];
+  if (steps.empty()) return 0;
+  std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
+  const double target = ratio * steps[steps.size() / 2];
   if (!std::isfinite(target)) return 0;
   if (model.inertia_scale.empty()) model.inertia_scale.assign(n, 1.0f);
   size_t scaled = 0;
   for (size_t i = 0; i < n; ++i) {
-    if (model.inverse_mass[i] == 0 || std::min(stiffness_dt[i], damping_dt[i]) >= target) continue;
+    const ParticleBound& b = bounds[i];
+    if (model.inverse_mass[i] == 0 || b.step() >= target) continue;
     // The stiffness term grows as sqrt(scale), the damping term as scale.
-    const double s = std::max({1.0, (target / stiffness_dt[i]) * (target / stiffness_dt[i]), target / damping_dt[i]});
+    const double s = std::max({1.0, (target / b.stiffness) * (target / b.stiffness), target / b.damping});
     model.inertia_scale[i] = static_cast<float>(model.inertia_scale[i] * s);
     model.inverse_mass[i] = 1.0f / model.inertial_mass(i);
     ++scaled;

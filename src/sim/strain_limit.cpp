@@ -139,17 +139,22 @@ ContactPlanes contact_planes(const StepContext& c) {
           c.settings.friction >= 0 ? c.settings.friction : c.model.fabric.friction};
 }
 
-// Position modification (Provot) of strain-limited spring s, for run_passes: a correction beyond
-// `tolerance` (a fraction of the rest length) counts.
-auto position_limit(const StepContext& c, float tolerance, ContactPlanes contacts) {
-  return [&m = c.model, x = c.state.x.data(), stretch = 1.0f + c.settings.strain_threshold, tolerance, contacts](size_t s) {
+// Position modification (Provot) of strain-limited spring s, for run_passes and the converge passes:
+// a correction beyond `tolerance` (a fraction of the rest length) counts. Its ends are kept out of
+// the body after a correction that counts, or after any visit with `keep_out_always` (the converge
+// passes, whose sub-tolerance corrections add up over their many passes).
+auto position_limit(const StepContext& c, float tolerance, ContactPlanes contacts, bool keep_out_always = false) {
+  return [&m = c.model, x = c.state.x.data(), stretch = 1.0f + c.settings.strain_threshold, tolerance, contacts,
+          keep_out_always](size_t s) {
     const uint32_t a = m.limit_a[s], b = m.limit_b[s];
     const float rest = m.limit_rest[s];
-    if (!limit_spring_position(x[a], x[b], m.inverse_mass[a], m.inverse_mass[b], stretch * rest, tolerance * rest))
-      return Change::None;
-    contacts.keep_out(x, a);
-    contacts.keep_out(x, b);
-    return Change::Corrected;
+    const bool corrected =
+        limit_spring_position(x[a], x[b], m.inverse_mass[a], m.inverse_mass[b], stretch * rest, tolerance * rest);
+    if (corrected || keep_out_always) {
+      contacts.keep_out(x, a);
+      contacts.keep_out(x, b);
+    }
+    return corrected ? Change::Corrected : Change::None;
   };
 }
 
@@ -165,7 +170,6 @@ auto position_hold(const StepContext& c) {
 StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, int converge_passes) {
   const ClothModel& m = c.model;
   Vec3f* x = c.state.x.data();
-  const float* w = m.inverse_mass.data();
   const float stretch = 1.0f + c.settings.strain_threshold;
   const auto hold = position_hold(c);
   const ContactPlanes contacts = contact_planes(c);
@@ -197,14 +201,8 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   Vec3f* x_start = c.scratch.converge_start.data();
   std::copy(x, x + m.particle_count(), x_start);
   size_t count = 0;
-  const auto correct = [&](uint32_t s) {
-    const uint32_t a = m.limit_a[s], b = m.limit_b[s];
-    const float rest = m.limit_rest[s];
-    const bool corrected = limit_spring_position(x[a], x[b], w[a], w[b], stretch * rest, kConvergeTolerance * rest);
-    contacts.keep_out(x, a);
-    contacts.keep_out(x, b);
-    return corrected ? 1u : 0u;
-  };
+  const auto limit = position_limit(c, kConvergeTolerance, contacts, /*keep_out_always=*/true);
+  const auto correct = [&](uint32_t s) { return limit(s) == Change::Corrected ? 1u : 0u; };
   for (int pass = 0; pass < converge_passes; ++pass) {
     if (pass % kRegather == 0) {
       count = 0;

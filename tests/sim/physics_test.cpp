@@ -191,7 +191,8 @@ TEST(ClothPhysics, RingTooSmallForAPostComesToRestOnIt) {
 // answered in the position passes (the ring's pull into the post is undone there), which apply
 // friction too (keep_out_of_contact). This simple ring held on the old code as well (its grip came
 // from the velocity response); the garments where it mattered are trousers held on the hips at the
-// longer step of mass scaling (BuiltinFit trousers XL on the default male body slid 0.57 m without it).
+// longer step of mass scaling (BuiltinFit trousers XL on the default male body slid 0.57 m in a trial
+// build without it).
 TEST(ClothPhysics, FrictionHoldsATightRingOnAPostAtAnyTimeStep) {
   constexpr uint32_t n = 24;
   constexpr float threshold = 0.05f, post_radius = 0.07f;

@@ -59,6 +59,17 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
     }
     nlohmann::ordered_json seams = nlohmann::ordered_json::array();
     for (size_t i = 0; i < seam_gap.size(); ++i) seams.push_back({{"seam", g.seam_names[i]}, {"max_gap_m", seam_gap[i]}});
+    nlohmann::ordered_json coarse = nullptr;  // started from the placement
+    if (g.coarse.edge > 0)
+      coarse = {{"edge_length_m", g.coarse.edge},
+                {"vertices", g.coarse.vertices},
+                {"iterations", g.coarse.iterations},
+                {"wall_seconds", g.coarse.wall_seconds},
+                {"status", std::string(to_string(g.coarse.status))},
+                {"seams_closed", g.coarse.seams_closed},
+                {"settled", g.coarse.settled},
+                {"extrapolated_vertices", g.coarse.extrapolated},
+                {"start_max_seam_gap_m", g.coarse.start_max_gap}};
     garments.push_back({{"name", g.name},
                         {"size", g.size},
                         {"size_reason", g.size_reason},
@@ -76,6 +87,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"seams", seams},
                         {"max_strain", st.max},
                         {"p99_strain", st.p99},
+                        {"coarse_start", coarse},
                         {"sewing_iterations", g.sewing_iterations},
                         {"sewn_max_strain", g.sewn_max_strain},
                         {"relax_passes", g.relax_passes},
@@ -103,6 +115,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
   extra["settings"] = {{"collision", std::string(to_string(o.collision))},
                        {"mesher", o.mesh.mesher == Mesher::grid ? "grid" : "triangle"},
                        {"edge_length_m", o.mesh.edge_length},
+                       {"coarse_edge_length_m", o.coarse_edge},
                        {"seam_closed_m", o.seam_closed_m},
                        {"settle_distance_m", o.settle_distance_m},
                        {"settle_window_s", o.settle_window_s},

@@ -97,7 +97,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     if (progress && g.state.iterations % 50 == 0)
       progress({index, count, phase, g.state.iterations, g.state.time, limit});
   };
-  g.initial_max_gap = seam_gap();
+  if (g.coarse.edge == 0) g.initial_max_gap = seam_gap();  // else dress() measured it before the coarse start
   if (!o.simulate) return;
 
   // Sewing: no gravity until every pair is closed.

@@ -32,4 +32,11 @@ struct GarmentCloth {
 GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh, const PlacedPanels& placed,
                                 const Fabric& fabric);
 
+// Coarse-to-fine (coarse_start.cpp): every fine particle placed where its flat-pattern point lies on
+// the dressed coarse garment of the same pattern (barycentric in the coarse panel's flat triangle
+// that holds it, or the nearest one), at rest. Panels are matched by index (`*_panels`: each panel's
+// first particle, then the end). Returns how many fine particles lay outside every coarse triangle.
+size_t start_from_coarse(ClothState& fine_state, const ClothModel& fine, std::span<const uint32_t> fine_panels,
+                         const ClothModel& coarse, const ClothState& coarse_state, std::span<const uint32_t> coarse_panels);
+
 }  // namespace drape::dressing

@@ -48,7 +48,29 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
   // Draping with selective mass scaling (on by default): the outline's light particles were scaled.
   EXPECT_GT(report["garments"][0]["mass_scaled_particles"].get<int>(), 0);
   EXPECT_GT(report["garments"][0]["strain_passes_per_iteration"].get<double>(), 0.0);
+  EXPECT_TRUE(report["garments"][0]["coarse_start"].is_null());  // coarse-to-fine is off by default
   EXPECT_TRUE(test::gltf_is_valid(dir / "dressed.glb"));
+}
+
+// --coarse-edge: the shirt dressed at twice the spacing first; report.json says so, and the totals
+// count both runs.
+TEST(DressCli, CoarseStartIsReported) {
+  const auto dir = test::temp_dir("dress_coarse");
+  const auto r = test::run_drape("dress --coarse-edge 0.052 --out " + dir.string());
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.exit_code << " " << r.err;
+  const nlohmann::json report = read_json(dir / "report.json");
+  const auto& g = report["garments"][0];
+  const auto& c = g["coarse_start"];
+  ASSERT_TRUE(c.is_object()) << g.dump();
+  EXPECT_EQ(c["edge_length_m"].get<double>(), 0.052);
+  EXPECT_LT(3 * c["vertices"].get<int>(), g["vertices"].get<int>());
+  EXPECT_GT(c["iterations"].get<int>(), 0);
+  EXPECT_EQ(c["status"], "ok");
+  EXPECT_EQ(report["settings"]["coarse_edge_length_m"].get<double>(), 0.052);
+  EXPECT_EQ(report["simulation"]["iterations"].get<int>(),
+            c["iterations"].get<int>() + g["sewing_iterations"].get<int>() + g["drape_iterations"].get<int>());
+  EXPECT_GT(g["initial_max_seam_gap_m"].get<double>(), 0.05);  // after placement
+  EXPECT_LT(c["start_max_seam_gap_m"].get<double>(), 0.005);   // from the coarse shirt
 }
 
 TEST(DressCli, MalformedGarmentIsRefusedAndNothingWritten) {
@@ -74,9 +96,13 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
   r = test::run_drape("dress --mass-scaling 2 --out " + (dir / "c").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--mass-scaling"), std::string::npos) << r.err;
+  r = test::run_drape("dress --coarse-edge -0.02 --out " + (dir / "d").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--coarse-edge"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "a"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b"));
   EXPECT_FALSE(std::filesystem::exists(dir / "c"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "d"));
 }
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {

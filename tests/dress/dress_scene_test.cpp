@@ -16,6 +16,7 @@
 #include "drape/dress.hpp"
 #include "drape/error.hpp"
 #include "dress/dress_support.hpp"
+#include "dress/stages.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
@@ -129,6 +130,64 @@ TEST(DressScene, FinerShirtIsRelaxedBeforeDrapingAndPassesTheGates) {
   EXPECT_GT(g.relax_passes, 0);
   expect_sound(r);
   EXPECT_TRUE(r.passed()) << failed_gates(r);
+}
+
+// Coarse-to-fine (DressOptions::coarse_edge): the same finer shirt is first dressed at the paper's
+// spacing, and starts from it with its seams already within the joining distance, so it is not
+// sewn again; then every gate at the fine resolution.
+TEST(DressScene, FinerShirtStartsFromTheCoarseOneAndPassesTheGates) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  DressOptions o;
+  o.mesh.edge_length = 0.013;
+  o.coarse_edge = kPaperEdgeLength;
+  const DressResult r = dress(cached_body(Sex::Female), {{load_garment(default_garment_name()), ""}}, o);
+  ASSERT_EQ(r.garments.size(), 1u);
+  const DressedGarment& g = r.garments[0];
+  EXPECT_EQ(g.coarse.edge, kPaperEdgeLength);
+  EXPECT_LT(4 * g.coarse.vertices, g.model.particle_count() + g.coarse.vertices);  // ~1/4 of the vertices
+  EXPECT_TRUE(g.coarse.seams_closed && g.coarse.settled);
+  EXPECT_LT(g.coarse.extrapolated, g.model.particle_count() / 20);  // outline curves past the coarse chords
+  EXPECT_LE(g.coarse.start_max_gap, o.seam_closed_m);  // placement leaves them ~0.18 m open
+  EXPECT_EQ(g.sewing_iterations, 0u);
+  EXPECT_EQ(r.simulation.iterations, g.coarse.iterations + g.state.iterations);
+  expect_sound(r);
+  EXPECT_TRUE(r.passed()) << failed_gates(r);
+}
+
+// start_from_coarse interpolates the coarse garment linearly over its flat pattern: a coarse garment
+// lying as an affine image of its flat pattern (here rotated, sheared and lifted) puts every fine
+// particle at that image of its own flat point, inside the coarse outline and (extended) beyond it.
+TEST(DressScene, CoarseStartInterpolatesOverTheFlatPattern) {
+  const Body& body = cached_body(Sex::Female);
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::image);
+  const Garment garment = garment_in_size(load_garment("skirt"), "M");
+  DressOptions coarse_o, fine_o;
+  coarse_o.mesh.edge_length = 0.05;
+  fine_o.mesh.edge_length = 0.02;
+  const DressedGarment coarse = prepare_garment(body, garment, *collider, coarse_o);
+  DressedGarment fine = prepare_garment(body, garment, *collider, fine_o);
+  ASSERT_EQ(coarse.panel_first_vertex.size(), fine.panel_first_vertex.size());
+  ASSERT_GT(fine.model.particle_count(), 4 * coarse.model.particle_count());
+  // One affine map per panel (distinct, so a particle placed from the wrong panel shows).
+  const auto image = [](size_t panel, const Vec2f& u) {
+    const float p = static_cast<float>(panel);
+    return Vec3f(0.8f * u.x() + 0.3f * u.y() + p, -0.2f * u.x() + 0.9f * u.y() + 1.0f, 0.5f * u.x() - 0.4f * u.y() - 2 * p);
+  };
+  ClothState coarse_state = coarse.state;
+  for (size_t p = 0; p + 1 < coarse.panel_first_vertex.size(); ++p)
+    for (uint32_t i = coarse.panel_first_vertex[p]; i < coarse.panel_first_vertex[p + 1]; ++i)
+      coarse_state.x[i] = image(p, coarse.model.flat_position[i]);
+  for (Vec3f& v : fine.state.v) v = Vec3f::Ones();
+  const size_t outside = dressing::start_from_coarse(fine.state, fine.model, fine.panel_first_vertex, coarse.model,
+                                                     coarse_state, coarse.panel_first_vertex);
+  EXPECT_LT(outside, fine.model.particle_count() / 10);
+  float worst = 0;
+  for (size_t p = 0; p + 1 < fine.panel_first_vertex.size(); ++p)
+    for (uint32_t i = fine.panel_first_vertex[p]; i < fine.panel_first_vertex[p + 1]; ++i) {
+      worst = std::max(worst, (fine.state.x[i] - image(p, fine.model.flat_position[i])).norm());
+      EXPECT_EQ(fine.state.v[i], Vec3f::Zero()) << i;
+    }
+  EXPECT_LT(worst, 1e-5f);
 }
 
 TEST(DressScene, ShirtOtherSizesOnDefaultBody) {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <string>
 
 #include "drape/dress.hpp"
 
@@ -100,10 +101,14 @@ int register_table2() {
   };
   for (const PaperRow& row : kTable2)
     for (int scale : {1, 4, 16}) add(std::string(row.garment) + "/x" + std::to_string(scale), row, {.scale = scale});
-  // Coarse-to-fine: the finer rows started from the garment dressed at the paper's spacing.
-  for (const PaperRow& row : kTable2)
+  // Coarse-to-fine: the finer rows started from the garment dressed at the paper's spacing. The
+  // skirt and shirt only: the trousers and dress at 16x fail from it (docs/dressing.md,
+  // "Coarse-to-fine") after 5 s of draping, which would add ~15 minutes to `make bench`.
+  for (const PaperRow& row : kTable2) {
+    if (std::string(row.garment) != "skirt" && std::string(row.garment) != "shirt") continue;
     for (int scale : {4, 16})
       add(std::string(row.garment) + "/x" + std::to_string(scale) + "/coarse", row, {.scale = scale, .coarse = true});
+  }
   // The same shirt with DressOptions::directional_time_step (a longer step from the same bound).
   add("shirt/x1/directional_dt", kTable2[1], {.directional = true});
   add("shirt/x16/body50k", kTable2[1], {.scale = 16, .fine_body = true});

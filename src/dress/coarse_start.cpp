@@ -12,8 +12,10 @@
 // Point location is by hand (a bucket grid over each coarse panel's flat triangles): it is a few
 // lines, runs once per garment, and no library here locates points in a 2D triangle soup.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
 #include "dress/stages.hpp"
 
@@ -130,6 +132,36 @@ size_t start_from_coarse(ClothState& fine_state, const ClothModel& fine, std::sp
     }
   }
   return extrapolated;
+}
+
+void dress_coarse_first(DressedGarment& fine, const Body& body, const Garment& garment, const Collider& body_collider,
+                        std::span<Collider* const> colliders, const DressOptions& options,
+                        const DressProgressCallback& progress, size_t index, size_t count) {
+  const auto t0 = std::chrono::steady_clock::now();
+  DressOptions co = options;
+  co.mesh.edge_length = options.coarse_edge;
+  co.coarse_edge = 0;
+  DressedGarment c = prepare_garment(body, garment, body_collider, co);
+  DressedGarment::CoarseRun& run = fine.coarse;
+  run.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const DressProgressCallback coarse_progress = [&](const DressProgress& p) {
+    if (!progress) return;
+    DressProgress q = p;
+    q.phase = std::string_view(p.phase) == "draping" ? "coarse draping" : "coarse sewing";
+    progress(q);
+  };
+  sew_and_drape(c, colliders, co, coarse_progress, index, count);
+  run.edge = options.coarse_edge;
+  run.vertices = c.model.particle_count();
+  run.iterations = c.state.iterations;
+  run.wall_seconds = c.sewing_seconds + c.drape_seconds;
+  run.seams_closed = c.seams_closed;
+  run.settled = c.settled;
+  run.status = c.status;
+  // An exploded coarse run is no start: the fine garment starts from its placement.
+  if (c.status == StepStatus::Ok)
+    run.extrapolated = start_from_coarse(fine.state, fine.model, fine.panel_first_vertex, c.model, c.state, c.panel_first_vertex);
+  run.start_max_gap = seam_gap_stats(fine.state.x, fine.seam_pairs).max;
 }
 
 }  // namespace drape::dressing

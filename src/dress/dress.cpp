@@ -1,7 +1,6 @@
 // The dressing pipeline (Vassilev & Spanlang sec. 6, docs/dressing.md): each garment in turn is
 // meshed, placed, sewn and draped with the body and the garments already dressed as colliders.
 #include <chrono>
-#include <string_view>
 
 #include "dress/stages.hpp"
 #include "dress/waistband.hpp"
@@ -28,6 +27,7 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   g.panel_first_vertex = std::move(cloth.panel_first_vertex);
   for (const Panel& p : garment.panels) g.panel_names.push_back(p.name);
   g.placement = std::move(placed.info);
+  g.initial_max_gap = seam_gap_stats(g.state.x, g.seam_pairs).max;
   return g;
 }
 
@@ -94,33 +94,9 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
     g.size_reason = size_reasons[i];
     result.setup_seconds += since(t0);
     if (o.coarse_edge > 1.25 * o.mesh.edge_length) {
-      // Coarse-to-fine: the same garment sewn and draped at the coarse spacing first.
-      t0 = clock();
-      DressOptions co = o;
-      co.mesh.edge_length = o.coarse_edge;
-      co.coarse_edge = 0;
-      DressedGarment c = prepare_garment(body, garments[i], *body_collider, co);
-      result.setup_seconds += since(t0);
-      const DressProgressCallback coarse_progress = [&](const DressProgress& p) {
-        if (!progress) return;
-        DressProgress q = p;
-        q.phase = std::string_view(p.phase) == "draping" ? "coarse draping" : "coarse sewing";
-        progress(q);
-      };
-      sew_and_drape(c, colliders, co, coarse_progress, i, garments.size());
-      g.coarse.edge = o.coarse_edge;
-      g.coarse.vertices = c.model.particle_count();
-      g.coarse.iterations = c.state.iterations;
-      g.coarse.wall_seconds = c.sewing_seconds + c.drape_seconds;
-      g.coarse.seams_closed = c.seams_closed;
-      g.coarse.settled = c.settled;
-      g.coarse.status = c.status;
-      // An exploded coarse run is no start: the fine garment starts from its placement.
-      g.initial_max_gap = seam_gap_stats(g.state.x, g.seam_pairs).max;  // after placement, as without
-      if (c.status == StepStatus::Ok)
-        g.coarse.extrapolated = dressing::start_from_coarse(g.state, g.model, g.panel_first_vertex, c.model, c.state, c.panel_first_vertex);
-      g.coarse.start_max_gap = seam_gap_stats(g.state.x, g.seam_pairs).max;
-      result.simulation.iterations += c.state.iterations;
+      dressing::dress_coarse_first(g, body, garments[i], *body_collider, colliders, o, progress, i, garments.size());
+      result.setup_seconds += g.coarse.setup_seconds;
+      result.simulation.iterations += g.coarse.iterations;
       result.simulation.wall_seconds += g.coarse.wall_seconds;
     }
     sew_and_drape(g, colliders, o, progress, i, garments.size());

@@ -92,12 +92,10 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   g.time_step = dt;
   StepScratch scratch(g.model, std::max<size_t>(colliders.size(), 1));
   const uint64_t cap = o.max_iterations ? o.max_iterations : std::numeric_limits<uint64_t>::max();
-  const auto seam_gap = [&] { return seam_gap_stats(g.state.x, g.seam_pairs).max; };
   const auto report = [&](const char* phase, double limit) {
     if (progress && g.state.iterations % 50 == 0)
       progress({index, count, phase, g.state.iterations, g.state.time, limit});
   };
-  if (g.coarse.edge == 0) g.initial_max_gap = seam_gap();  // else dress() measured it before the coarse start
   if (!o.simulate) return;
 
   // Sewing: no gravity until every pair is closed.

@@ -39,4 +39,11 @@ GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh,
 size_t start_from_coarse(ClothState& fine_state, const ClothModel& fine, std::span<const uint32_t> fine_panels,
                          const ClothModel& coarse, const ClothState& coarse_state, std::span<const uint32_t> coarse_panels);
 
+// Coarse-to-fine (coarse_start.cpp, DressOptions::coarse_edge): `garment` meshed, placed, sewn and
+// draped at the coarse spacing, then `fine` started from it (unless the coarse run failed: then
+// `fine` keeps its placement); `fine.coarse` says how the coarse run went and what it cost.
+void dress_coarse_first(DressedGarment& fine, const Body& body, const Garment& garment, const Collider& body_collider,
+                        std::span<Collider* const> colliders, const DressOptions& options,
+                        const DressProgressCallback& progress, size_t index, size_t count);
+
 }  // namespace drape::dressing

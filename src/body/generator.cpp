@@ -477,7 +477,7 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
   return body;
 }
 
-Body default_body(Sex sex) {
+Body generate_default_body(Sex sex) {
   // Everything but shoulder width and back length, which follow from the chest and the height.
   MeasurementRequest request = average(sex);
   request.erase("shoulder_width");

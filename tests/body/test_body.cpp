@@ -4,11 +4,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <span>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "body/baked.hpp"
 #include "body/surface_nets.hpp"
 #include "drape/body.hpp"
 #include "drape/error.hpp"
@@ -173,7 +176,6 @@ TEST(BodyFromMeasurements, AllKeysAtOnce) {
 }
 
 TEST(BodyFromMeasurements, DefaultBodiesAreAverageAdults) {
-  if (sanitized()) GTEST_SKIP() << "slow under sanitizers";
   const Body female = default_body(Sex::Female);
   const Body male = default_body(Sex::Male);
   expect_valid_body(female, "default female");
@@ -384,4 +386,68 @@ TEST(BodyCommand, WritesRiggedGlbAndRefusesBadMeasurements) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--measurements"), std::string::npos) << bad.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad.glb"));
+}
+
+// The default bodies are baked into the binary at build time (src/default_bodies): what
+// default_body returns must be what the generator makes, bit for bit, analysis and rig included.
+TEST(DefaultBodies, BakedBodyIsTheGeneratorsBody) {
+  if (sanitized()) GTEST_SKIP() << "slow under sanitizers (the generator polygonises several times)";
+  for (const Sex sex : {Sex::Female, Sex::Male}) {
+    const Body baked = default_body(sex);
+    const Body made = generate_default_body(sex);
+    const char* who = sex == Sex::Female ? "female" : "male";
+    ASSERT_EQ(baked.mesh.positions.size(), made.mesh.positions.size()) << who;
+    EXPECT_TRUE(baked.mesh.positions == made.mesh.positions) << who;
+    EXPECT_TRUE(baked.mesh.normals == made.mesh.normals) << who;
+    EXPECT_TRUE(baked.mesh.triangles == made.mesh.triangles) << who;
+    EXPECT_TRUE(baked.mesh.joints == made.mesh.joints) << who;
+    EXPECT_TRUE(baked.mesh.weights == made.mesh.weights) << who;
+    EXPECT_TRUE(baked.parts == made.parts) << who;
+    EXPECT_EQ(baked.mesh.name, made.mesh.name);
+    EXPECT_EQ(baked.sex, made.sex);
+    for (const auto& row : measurement_table())
+      EXPECT_EQ(baked.measurements.*(row.field), made.measurements.*(row.field)) << who << " " << row.key;
+    const auto a = baked.landmarks.named(), b = made.landmarks.named();
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].second == b[i].second) << who << " " << a[i].first;
+    ASSERT_EQ(baked.skeleton.joints.size(), made.skeleton.joints.size());
+    for (size_t j = 0; j < baked.skeleton.joints.size(); ++j)
+      EXPECT_TRUE(baked.skeleton.joints[j].position == made.skeleton.joints[j].position) << baked.skeleton.joints[j].name;
+  }
+}
+
+// The bake format round-trips, and damaged bytes are refused rather than read past their end.
+TEST(DefaultBodies, BakeFormatRoundTripsAndRefusesDamagedBytes) {
+  Mesh mesh;
+  mesh.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  mesh.normals = {Vec3f(0, 0, 1), Vec3f(0, 0, 1), Vec3f(0, 0, 1)};
+  mesh.triangles = {Tri{0, 1, 2}};
+  Mesh other = mesh;
+  other.positions[2] = Vec3f(0, 2, 0);
+  const std::string bytes = body::encode_baked_bodies({{Sex::Female, mesh}, {Sex::Male, other}});
+  const std::span<const unsigned char> span(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+  const Mesh male = body::decode_baked_body(span, Sex::Male);
+  EXPECT_TRUE(male.positions == other.positions);
+  EXPECT_TRUE(male.normals == other.normals);
+  EXPECT_TRUE(male.triangles == other.triangles);
+  EXPECT_TRUE(body::decode_baked_body(span, Sex::Female).positions == mesh.positions);
+
+  auto refused = [](std::span<const unsigned char> b, const std::string& why) {
+    try {
+      body::decode_baked_body(b, Sex::Male);
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      return;
+    }
+    ADD_FAILURE() << "accepted damaged bytes (" << why << ")";
+  };
+  refused(span.first(span.size() - 5), "truncated");
+  std::string bad_magic = bytes;
+  bad_magic[0] = 'X';
+  refused({reinterpret_cast<const unsigned char*>(bad_magic.data()), bad_magic.size()}, "not a DRAPEBB1");
+  std::string bad_index = bytes;
+  const uint32_t past = 7;
+  std::memcpy(bad_index.data() + bad_index.size() - sizeof past, &past, sizeof past);
+  refused({reinterpret_cast<const unsigned char*>(bad_index.data()), bad_index.size()}, "past the end");
+  const std::string female_only = body::encode_baked_bodies({{Sex::Female, mesh}});
+  refused({reinterpret_cast<const unsigned char*>(female_only.data()), female_only.size()}, "no body of the requested sex");
 }

@@ -180,6 +180,17 @@ BENCHMARK_CAPTURE(BM_Update, sdf_arm, CollisionMethod::sdf, true)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
 
+// Building a collider for a static body, what `drape dress` does once per body before the first
+// step (the image collider's candidate grid lists only the cells over its hidden pixels).
+void BM_Build(benchmark::State& state, CollisionMethod method) {
+  if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
+  size_t memory = 0;
+  for (auto _ : state) memory = make_body_collider(*body(), method)->build_stats().memory_bytes;
+  state.counters["memory_MB"] = static_cast<double>(memory) / 1e6;
+}
+BENCHMARK_CAPTURE(BM_Build, image, CollisionMethod::image)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Build, bvh, CollisionMethod::bvh)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 void BM_InsideTest(benchmark::State& state) {
   if (!body()) return state.SkipWithError("needs ../shared/data/bodies/garmentcode/mean_all.obj");
   const InsideTest test(*body());

@@ -9,7 +9,7 @@
 
 namespace drape::collision {
 
-CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band)
+CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band, const CellFilter& wanted)
     : surface_(bvh.surface()), cell_(cell), band_(band), half_diagonal_(0.5f * std::sqrt(3.0f) * cell) {
   if (!(cell > 0) || !(band > 0)) throw std::invalid_argument("candidate grid: cell and band must be positive");
   if (surface_.triangle_count() >= kTruncated) throw std::invalid_argument("candidate grid: more than 16.7 million triangles");
@@ -77,6 +77,7 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band)
   const size_t chunks = (marked.size() + kChunk - 1) / kChunk;
   std::vector<std::vector<Candidate>> chunk_candidates(chunks);
   std::vector<uint32_t> count(cells, 0);
+  std::vector<size_t> listed(chunks, 0);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(chunks); ++k) {
     std::vector<uint32_t> within;
@@ -92,6 +93,12 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band)
       const size_t c = marked[m];
       const Vec3f centre = origin_ + cell_ * Vec3f(static_cast<float>(c % nx) + 0.5f, static_cast<float>((c / nx) % ny) + 0.5f,
                                                    static_cast<float>(c / (nx * ny)) + 0.5f);
+      if (wanted && !wanted(Bounds{centre - Vec3f::Constant(0.5f * cell_), centre + Vec3f::Constant(0.5f * cell_)})) {
+        // Not asked here: "the list goes on beyond this entry" from the start, so the tree answers.
+        out.push_back({static_cast<uint16_t>(kTruncated & 0xffff), static_cast<uint8_t>(kTruncated >> 16), {0, 0, 0}, 0});
+        count[c] = 1;
+        continue;
+      }
       SurfaceHit nearest;
       if (!bvh.closest(centre, band_, nearest)) continue;
       // U: no point of the cell is farther than U from the body (the farthest corner from the
@@ -129,8 +136,10 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band)
                        static_cast<uint16_t>(std::min(units, 65535.0f))});
       }
       count[c] = static_cast<uint32_t>(out.size() - first);
+      listed[static_cast<size_t>(k)] += count[c] > 0;
     }
   }
+  for (size_t n : listed) listed_cells_ += n;
   first_.assign(cells + 1, 0);
   for (size_t c = 0; c < cells; ++c) first_[c + 1] = first_[c] + count[c];
   candidates_.reserve(first_[cells]);

@@ -18,6 +18,7 @@
 // reaches the best distance so far and stops once d(c, T) - |p - c| does (no later one can be
 // nearer). Cells beyond the band store no list: a point there is at least band - r from the body.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "collision/body_surface.hpp"
@@ -29,7 +30,11 @@ class TriangleBvh;
 class CandidateGrid {
  public:
   // Built over the surface's current pose, with the BVH (same pose) answering the build's searches.
-  CandidateGrid(const TriangleBvh& bvh, float cell, float band);
+  // `wanted` (optional): only cells whose box it accepts get a list; the others, where a caller
+  // never asks (the image collider asks only over its hidden pixels), hold a kTruncated entry at
+  // distance 0, so a query there goes to the tree: answers stay exact wherever they are asked.
+  using CellFilter = std::function<bool(const Bounds& cell)>;
+  CandidateGrid(const TriangleBvh& bvh, float cell, float band, const CellFilter& wanted = {});
 
   enum class Answer : uint8_t { kFound, kNone, kUnknown, kTruncatedFound, kTruncatedNone };
   // kFound: hit is the exact nearest point, within radius. kNone: nothing lies within radius.
@@ -57,6 +62,7 @@ class CandidateGrid {
     return first_.size() * sizeof(uint32_t) + candidates_.size() * sizeof(Candidate) + records_.size() * sizeof(Record);
   }
   double mean_list_length() const;
+  size_t listed_cells() const { return listed_cells_; }  // cells that got a list of their own
 
  private:
   // A copy of one triangle's corners next to its id, in Morton order of the centroids: a cell's
@@ -93,6 +99,7 @@ class CandidateGrid {
   std::vector<Candidate> candidates_;
   std::vector<Record> records_;
   std::vector<uint32_t> record_of_;  // triangle -> its record
+  size_t listed_cells_ = 0;
 };
 
 }  // namespace drape::collision

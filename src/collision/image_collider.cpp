@@ -19,11 +19,28 @@ ImageCollider::ImageCollider(const Mesh& body, const BodyColliderOptions& option
   if (!(options.pixel_size > 0)) throw std::invalid_argument("image collider: pixel size must be positive");
   if (options_.hidden_region_handling) {
     bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
-    bvh_->build_candidate_grid();
     reversed_.reserve(surface_.triangle_count());
     for (const Tri& t : surface_.triangles()) reversed_.push_back({t[0], t[2], t[1]});
   }
   render_maps();
+  if (bvh_) {
+    // The tree answers only over hidden pixels (sample()), so the candidate grid lists only the
+    // cells above them: a fifth of the body's band or less, the rest of the grid's build time saved.
+    // A cell counts when its box, grown by a pixel for the rounding of cell and pixel indices,
+    // meets a hidden pixel.
+    const float h = options_.pixel_size;
+    bvh_->build_candidate_grid(TriangleBvh::kGridCell, TriangleBvh::kGridBand, [this, h](const Bounds& cell) {
+      const int i0 = std::max(0, static_cast<int>(std::floor((cell.min.x() - origin_.x()) / h)) - 1);
+      const int j0 = std::max(0, static_cast<int>(std::floor((cell.min.y() - origin_.y()) / h)) - 1);
+      const int i1 = std::min(width_ - 1, static_cast<int>(std::floor((cell.max.x() - origin_.x()) / h)) + 1);
+      const int j1 = std::min(height_ - 1, static_cast<int>(std::floor((cell.max.y() - origin_.y()) / h)) + 1);
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i)
+          if (hidden_[static_cast<size_t>(j) * static_cast<size_t>(width_) + static_cast<size_t>(i)]) return true;
+      return false;
+    });
+    stats_.memory_bytes += bvh_->candidate_grid()->memory_bytes();
+  }
 }
 
 void ImageCollider::set_surface(std::span<const Vec3f> positions, double t) {

@@ -99,9 +99,9 @@ void TriangleBvh::update() {
   rtcCommitScene(scene_);
 }
 
-void TriangleBvh::build_candidate_grid(float cell, float band) {
+void TriangleBvh::build_candidate_grid(float cell, float band, const CandidateGrid::CellFilter& wanted) {
   grid_.reset();
-  grid_ = std::make_unique<CandidateGrid>(*this, cell, band);
+  grid_ = std::make_unique<CandidateGrid>(*this, cell, band, wanted);
 }
 
 bool TriangleBvh::finish(CandidateGrid::Answer answer, const Vec3f& p, float radius, SurfaceHit& hit) const {

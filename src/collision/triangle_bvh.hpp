@@ -33,7 +33,9 @@ class TriangleBvh {
   void update();
 
   // Builds the candidate grid for the current pose (cells of `cell` metres within `band` of the surface).
-  void build_candidate_grid(float cell = 0.007f, float band = 0.016f);
+  // `wanted`: see CandidateGrid (lists only where queries will come).
+  static constexpr float kGridCell = 0.007f, kGridBand = 0.016f;
+  void build_candidate_grid(float cell = kGridCell, float band = kGridBand, const CandidateGrid::CellFilter& wanted = {});
   const CandidateGrid* candidate_grid() const { return grid_.get(); }
 
   // Nearest point of the body to p within `radius`; false when there is none. Thread-safe.

@@ -63,5 +63,42 @@ TEST(CandidateGrid, AnswersExactlyAsTheTree) {
   EXPECT_EQ(bvh.candidate_grid(), nullptr);
 }
 
+// A grid that lists only some cells (the image collider lists those above its hidden pixels) still
+// answers exactly everywhere: a cell left out sends its queries to the tree.
+TEST(CandidateGrid, CellsLeftOutAskTheTree) {
+  const auto path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
+  const Mesh body = read_mesh(path);
+  const BodySurface surface(body.positions, body.triangles);
+  TriangleBvh bvh(surface, /*refit=*/true);
+  bvh.build_candidate_grid();
+  const size_t all_listed = bvh.candidate_grid()->listed_cells();
+  // Only the body's left half (x > 0) and the cells above the waist.
+  bvh.build_candidate_grid(TriangleBvh::kGridCell, TriangleBvh::kGridBand,
+                           [](const Bounds& cell) { return cell.min.x() > 0.0f || cell.min.y() > 1.0f; });
+  const size_t some_listed = bvh.candidate_grid()->listed_cells();
+  EXPECT_GT(some_listed, all_listed / 5);
+  EXPECT_LT(some_listed, all_listed * 4 / 5);
+  const auto normals = vertex_normals(body.positions, body.triangles);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<size_t> vertex(0, body.positions.size() - 1);
+  std::uniform_real_distribution<float> offset(-0.03f, 0.03f);
+  const int count = std::getenv("DRAPE_SANITIZED") ? 1000 : 10000;
+  int found = 0;
+  for (int i = 0; i < count; ++i) {
+    const size_t v = vertex(rng);
+    const Vec3f p = body.positions[v] + offset(rng) * normals[v];
+    for (float radius : {0.005f, 0.02f}) {
+      SurfaceHit grid_hit, tree_hit;
+      const bool in_grid = bvh.closest(p, radius, grid_hit);
+      ASSERT_EQ(in_grid, bvh.closest_in_tree(p, radius, tree_hit)) << "point " << p.transpose() << " radius " << radius;
+      if (in_grid) {
+        ASSERT_NEAR(grid_hit.distance, tree_hit.distance, 1e-6f) << "point " << p.transpose();
+        ++found;
+      }
+    }
+  }
+  EXPECT_GT(found, count / 2);
+}
+
 }  // namespace
 }  // namespace drape::collision

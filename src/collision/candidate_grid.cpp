@@ -80,7 +80,7 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band, con
   std::vector<size_t> listed(chunks, 0);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(chunks); ++k) {
-    std::vector<uint32_t> within;
+    std::vector<SurfaceHit> within;
     struct Pending {
       uint32_t record;
       float distance;
@@ -113,8 +113,8 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band, con
       // it can be nearest somewhere in the cell only if d - h(u) <= U; those all lie within U + r.
       bvh.within(centre, reach + half_diagonal_, within);
       list.clear();
-      for (uint32_t t : within) {
-        const SurfaceHit h = surface_.closest_on(t, centre);
+      for (const SurfaceHit& h : within) {
+        const uint32_t t = h.triangle;
         const Vec3f away = h.distance > 0.0f ? Vec3f((centre - h.where.point) / h.distance) : Vec3f::Zero();
         if (h.distance - 0.5f * cell_ * away.lpNorm<1>() > reach + 1e-5f) continue;  // 10 um for rounding
         list.push_back({record_of_[t], h.distance, away});

@@ -32,14 +32,15 @@ bool visit_triangle(RTCPointQueryFunctionArguments* args) {
 
 struct WithinState {
   const BodySurface* surface;
-  std::vector<uint32_t>* triangles;
+  std::vector<SurfaceHit>* hits;
 };
 
-// Collects every triangle within the (fixed) query radius.
+// Collects every triangle within the (fixed) query radius, with its nearest point.
 bool collect_triangle(RTCPointQueryFunctionArguments* args) {
   auto* state = static_cast<WithinState*>(args->userPtr);
   const Vec3f p(args->query->x, args->query->y, args->query->z);
-  if (state->surface->closest_on(args->primID, p).distance <= args->query->radius) state->triangles->push_back(args->primID);
+  const SurfaceHit hit = state->surface->closest_on(args->primID, p);
+  if (hit.distance <= args->query->radius) state->hits->push_back(hit);
   return false;
 }
 
@@ -146,15 +147,18 @@ void TriangleBvh::closest_batch(std::span<const Vec3f> points, float radius, std
   }
 }
 
-void TriangleBvh::within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const {
-  triangles.clear();
+void TriangleBvh::within(const Vec3f& p, float radius, std::vector<SurfaceHit>& hits) const {
+  hits.clear();
   RTCPointQuery query = point_query(p, radius);
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
-  WithinState state{&surface_, &triangles};
+  WithinState state{&surface_, &hits};
   rtcPointQuery(scene_, &query, &context, collect_triangle, &state);
-  std::sort(triangles.begin(), triangles.end());  // a tree may reference a triangle from several leaves
-  triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
+  // A tree may reference a triangle from several leaves.
+  const auto by_triangle = [](const SurfaceHit& a, const SurfaceHit& b) { return a.triangle < b.triangle; };
+  std::sort(hits.begin(), hits.end(), by_triangle);
+  hits.erase(std::unique(hits.begin(), hits.end(), [](const SurfaceHit& a, const SurfaceHit& b) { return a.triangle == b.triangle; }),
+             hits.end());
 }
 
 bool TriangleBvh::closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const {

@@ -45,8 +45,8 @@ class TriangleBvh {
   void closest_batch(std::span<const Vec3f> points, float radius, std::span<SurfaceHit> hits, std::span<uint8_t> found) const;
   // Nearest point through the tree only (no candidate grid).
   bool closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const;
-  // Every triangle within `radius` of p (cleared first), in the tree's order.
-  void within(const Vec3f& p, float radius, std::vector<uint32_t>& triangles) const;
+  // Every triangle within `radius` of p with its point nearest p (cleared first), by triangle id.
+  void within(const Vec3f& p, float radius, std::vector<SurfaceHit>& hits) const;
 
   const BodySurface& surface() const { return surface_; }
 

@@ -25,7 +25,10 @@ void run_body(const BodyArgs& args) {
   const MeasurementRequest request = args.measurements.empty() ? MeasurementRequest{} : parse_measurements(args.measurements);
   BodyBuildOptions options;
   options.grid_step = args.grid;
-  const Body body = request.empty() ? default_body(sex) : make_body(sex, request, options);
+  // No measurements: the built-in body, baked into the binary at the default grid, made now at another.
+  const Body body = !request.empty()                               ? make_body(sex, request, options)
+                    : options.grid_step != BodyBuildOptions{}.grid_step ? generate_default_body(sex, options)
+                                                                   : default_body(sex);
   write_scene(args.out, body_scene(body));
 
   nlohmann::json j;

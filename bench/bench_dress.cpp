@@ -34,9 +34,8 @@ const Body& body(bool fine) {
   auto it = bodies.find(fine);
   if (it == bodies.end()) {
     BodyBuildOptions o;
-    if (fine) o.grid_step = 0.0085f;  // about 50k triangles
-    it = bodies.emplace(fine, fine ? make_body(Sex::Female, default_measurements(Sex::Female), o)
-                                   : default_body(Sex::Female)).first;
+    o.grid_step = 0.0095f;  // the default body with 50.1k triangles (the 50k-triangle body)
+    it = bodies.emplace(fine, fine ? generate_default_body(Sex::Female, o) : default_body(Sex::Female)).first;
   }
   return it->second;
 }

@@ -137,7 +137,8 @@ Body make_body(Sex sex, const MeasurementRequest& request, const BodyBuildOption
 Body default_body(Sex sex);
 // The same body made now by the generator: make_body on the average measurements (what the build
 // runs; bit for bit the body default_body returns when built with the same compiler and flags).
-Body generate_default_body(Sex sex);
+// Other options (a finer grid) give the default body at another resolution.
+Body generate_default_body(Sex sex, const BodyBuildOptions& options = {});
 MeasurementRequest default_measurements(Sex sex);
 
 // ---- Bodies from files --------------------------------------------------------------------------

@@ -477,12 +477,12 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
   return body;
 }
 
-Body generate_default_body(Sex sex) {
+Body generate_default_body(Sex sex, const BodyBuildOptions& options) {
   // Everything but shoulder width and back length, which follow from the chest and the height.
   MeasurementRequest request = average(sex);
   request.erase("shoulder_width");
   request.erase("back_length");
-  return make_body(sex, request);
+  return make_body(sex, request, options);
 }
 
 }  // namespace drape

@@ -382,6 +382,17 @@ TEST(BodyCommand, WritesRiggedGlbAndRefusesBadMeasurements) {
   EXPECT_FALSE(nlohmann::json::parse(narrow.out)["measurements"]["shoulder_width"]["within_1cm"].get<bool>());
   EXPECT_TRUE(nlohmann::json::parse(narrow.out)["measurements"]["bust"]["within_1cm"].get<bool>());
 
+  // The default body at another grid is made now (the baked one is at the default grid): a coarser
+  // grid, fewer triangles, the same average adult.
+  const auto plain = drape::test::run_drape("body -o " + (dir / "plain.glb").string());
+  const auto coarse = drape::test::run_drape("body --grid 0.02 -o " + (dir / "coarse.glb").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
+  const auto plain_report = nlohmann::json::parse(plain.out), coarse_report = nlohmann::json::parse(coarse.out);
+  EXPECT_LT(coarse_report["triangles"].get<size_t>(), plain_report["triangles"].get<size_t>() / 2);
+  EXPECT_NEAR(coarse_report["measurements"]["hips"]["measured_m"].get<double>(),
+              plain_report["measurements"]["hips"]["measured_m"].get<double>(), 0.01);
+
   const auto bad = drape::test::run_drape("body --measurements waist=7.4 -o " + (dir / "bad.glb").string());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--measurements"), std::string::npos) << bad.err;

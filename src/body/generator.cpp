@@ -386,23 +386,26 @@ MeasurementRequest parse_measurements(std::string_view text) {
     const size_t eq = item.find('=');
     if (eq == std::string_view::npos)
       throw InputError("--measurements", "expected key=value, got '" + std::string(item) + "'");
-    const std::string key(item.substr(0, eq));
+    // `chest` is what a man's size label calls the girth drape measures as `bust` (ISO 8559-1 5.3.5).
+    const std::string typed(item.substr(0, eq));
+    const std::string key = typed == "chest" ? std::string("bust") : typed;
     const std::string_view number = item.substr(eq + 1);
     const auto& table = measurement_table();
     if (std::none_of(table.begin(), table.end(), [&](const MeasurementInfo& m) { return m.key == key; })) {
       std::string known;
       for (const auto& m : table) known += (known.empty() ? "" : ", ") + std::string(m.key);
-      throw InputError("--measurements", "unknown measurement '" + key + "' (known: " + known + ")");
+      throw InputError("--measurements", "unknown measurement '" + key + "' (known: " + known + "; chest = bust)");
     }
     float value = 0;
     const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
     if (ec != std::errc() || ptr != number.data() + number.size() || !std::isfinite(value))
-      throw InputError("--measurements", "'" + key + "' is not a number: '" + std::string(number) + "'");
+      throw InputError("--measurements", "'" + typed + "' is not a number: '" + std::string(number) + "'");
     const Range range = plausible(key);
     if (value < range.lo || value > range.hi)
-      throw InputError("--measurements", key + "=" + std::string(number) + " is outside " + std::to_string(range.lo) +
+      throw InputError("--measurements", typed + "=" + std::string(number) + " is outside " + std::to_string(range.lo) +
                                              "-" + std::to_string(range.hi) + " m (values are in metres)");
-    if (out.count(key)) throw InputError("--measurements", "'" + key + "' given twice");
+    if (out.count(key))
+      throw InputError("--measurements", "'" + key + "' given twice" + (key == "bust" ? " (chest is bust)" : ""));
     out[key] = value;
   }
   return out;

@@ -105,7 +105,9 @@ TEST(BodyMeasurements, ParsesKeysAndRefusesBadInput) {
   const auto m = parse_measurements("height=1.70,bust=0.92,waist=0.74");
   EXPECT_FLOAT_EQ(m.at("height"), 1.70f);
   EXPECT_FLOAT_EQ(m.at("waist"), 0.74f);
-  for (const char* bad : {"height=1.70,elbow=0.3", "bust=abc", "height=170", "waist", "waist=0.7,waist=0.8"}) {
+  EXPECT_FLOAT_EQ(parse_measurements("chest=1.04").at("bust"), 1.04f);  // a man's size label says chest
+  for (const char* bad : {"height=1.70,elbow=0.3", "bust=abc", "height=170", "waist", "waist=0.7,waist=0.8",
+                          "bust=1.0,chest=1.04"}) {
     try {
       parse_measurements(bad);
       ADD_FAILURE() << "accepted " << bad;

@@ -109,6 +109,9 @@ void run_dress(const DressArgs& a) {
                static_cast<unsigned long long>(result.simulation.iterations), result.simulation.wall_seconds,
                1e6 * result.simulation.seconds_per_iteration, 100.0 * q.max_strain, 1e3 * q.max_seam_gap_m,
                q.penetrating_vertices, q.settled ? "settled" : "not settled");
+  if (q.skin_through.body_vertices > 0)
+    std::fprintf(stderr, "skin shows through the cloth at %zu body vertices (up to %.1f mm; not a gate: report.json skin_through_cloth)\n",
+                 q.skin_through.body_vertices, 1e3 * q.skin_through.max_depth_m);
   std::fprintf(stderr, "wrote %s/dressed.glb, preview.png, report.json\n", a.out.c_str());
   if (!result.passed()) {
     for (const GateResult& g : result.gates)

@@ -28,6 +28,20 @@ SeamGapStats seam_gap_stats(std::span<const Vec3f> x, std::span<const std::array
 // 1 mm inside is a real failure of the collision handling, not tessellation noise.
 inline constexpr float kPenetrationTolerance = 0.001f;  // m
 
+// Skin showing through the cloth. The collision keeps the cloth's vertices off the body, not the
+// faces between them: over a tight, curved part (a shoulder under a sleeve cap) the skin between
+// two vertices 2-4 cm apart can rise through the flat triangle they span. From every body vertex a
+// ray goes into the body, against its normal, for `reach`; where it meets a garment triangle more
+// than `tolerance` deep, the cloth passes under the skin there. Skin the garment does not cover
+// (beyond a hem or a neckline) has no cloth under it and does not count. Reported, not gated.
+inline constexpr float kSkinThroughTolerance = 0.001f;  // m
+struct SkinThroughStats {
+  size_t body_vertices = 0;  // body vertices with cloth more than the tolerance under them
+  float max_depth_m = 0;     // deepest such cloth below the skin (0 when none)
+};
+SkinThroughStats measure_skin_through(const Mesh& body, std::span<const Vec3f> cloth, std::span<const Tri> triangles,
+                                      float reach = 0.015f, float tolerance = kSkinThroughTolerance);
+
 // DESIGN.md's `quality` object (over all garments), plus what the gates also need.
 struct FitQuality {
   float max_strain = 0;  // structural (l - l0) / l0
@@ -43,6 +57,8 @@ struct FitQuality {
   float lowest_y = 0;             // m, lowest garment vertex (the floor is y = 0)
   float drop_m = 0;               // how far the garments' centre of mass fell while draping
   size_t vertices = 0;
+  // Reported beside `quality`, not gated: measure_skin_through over every garment.
+  SkinThroughStats skin_through;
 };
 
 // Strain and penetration of one garment's state (seam gaps and settling come from the sewing).

@@ -161,6 +161,26 @@ void TriangleBvh::within(const Vec3f& p, float radius, std::vector<SurfaceHit>& 
              hits.end());
 }
 
+bool TriangleBvh::first_hit(const Vec3f& origin, const Vec3f& direction, float max_distance, float& distance) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit ray{};
+  ray.ray.org_x = origin.x();
+  ray.ray.org_y = origin.y();
+  ray.ray.org_z = origin.z();
+  ray.ray.dir_x = direction.x();
+  ray.ray.dir_y = direction.y();
+  ray.ray.dir_z = direction.z();
+  ray.ray.tnear = 0.0f;
+  ray.ray.tfar = max_distance;
+  ray.ray.mask = ~0u;
+  ray.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_, &context, &ray);
+  if (ray.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  distance = ray.ray.tfar;
+  return true;
+}
+
 bool TriangleBvh::closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const {
   RTCPointQuery query = point_query(p, radius);
   RTCPointQueryContext context;

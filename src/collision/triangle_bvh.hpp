@@ -45,6 +45,9 @@ class TriangleBvh {
   void closest_batch(std::span<const Vec3f> points, float radius, std::span<SurfaceHit> hits, std::span<uint8_t> found) const;
   // Nearest point through the tree only (no candidate grid).
   bool closest_in_tree(const Vec3f& p, float radius, SurfaceHit& hit) const;
+  // Distance along the ray from `origin` in the unit `direction` to the first triangle it meets
+  // within `max_distance` (either side of a triangle counts); false when none. Thread-safe.
+  bool first_hit(const Vec3f& origin, const Vec3f& direction, float max_distance, float& distance) const;
   // Every triangle within `radius` of p with its point nearest p (cleared first), by triangle id.
   void within(const Vec3f& p, float radius, std::vector<SurfaceHit>& hits) const;
 

@@ -52,6 +52,11 @@ FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garm
     gap_sum += static_cast<double>(gaps.mean) * static_cast<double>(gaps.pairs);
     gap_pairs += gaps.pairs;
     q.settled = q.settled && g.settled;
+    if (m.finite) {
+      const SkinThroughStats skin = measure_skin_through(body.mesh, g.state.x, g.model.triangles);
+      q.skin_through.body_vertices += skin.body_vertices;
+      q.skin_through.max_depth_m = std::max(q.skin_through.max_depth_m, skin.max_depth_m);
+    }
     q.lowest_y = std::min(q.lowest_y, m.lowest_y);
     q.drop_m = std::max(q.drop_m, g.drop_m);
   }

@@ -122,6 +122,10 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                        {"max_iterations", o.max_iterations},
                        {"mass_scaling", o.mass_scaling},
                        {"penetration_tolerance_m", kPenetrationTolerance}};
+  // Skin rising through the cloth between its vertices (drape/fit.hpp): reported, not gated.
+  extra["skin_through_cloth"] = {{"body_vertices", r.quality.skin_through.body_vertices},
+                                 {"max_depth_m", r.quality.skin_through.max_depth_m},
+                                 {"tolerance_m", kSkinThroughTolerance}};
   extra["setup_seconds"] = r.setup_seconds;
   return report_json(r.quality, r.simulation, r.gates, extra.dump());
 }

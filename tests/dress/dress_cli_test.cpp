@@ -49,6 +49,11 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
   EXPECT_GT(report["garments"][0]["mass_scaled_particles"].get<int>(), 0);
   EXPECT_GT(report["garments"][0]["strain_passes_per_iteration"].get<double>(), 0.0);
   EXPECT_TRUE(report["garments"][0]["coarse_start"].is_null());  // coarse-to-fine is off by default
+  // Skin through the cloth is reported (not gated), and said on the terminal when there is any.
+  const auto& skin = report["skin_through_cloth"];
+  const size_t through = skin["body_vertices"].get<size_t>();
+  EXPECT_EQ(through > 0, skin["max_depth_m"].get<double>() > skin["tolerance_m"].get<double>());
+  EXPECT_EQ(through > 0, r.err.find("skin shows through the cloth") != std::string::npos) << r.err;
   EXPECT_TRUE(test::gltf_is_valid(dir / "dressed.glb"));
 }
 

@@ -8,6 +8,7 @@
 #include "drape/analytic_colliders.hpp"
 #include "drape/cloth.hpp"
 #include "drape/fit.hpp"
+#include "drape/shapes.hpp"
 
 namespace drape {
 namespace {
@@ -61,6 +62,43 @@ TEST(MeasureGarment, PointsInsideASphereArePenetrating) {
   EXPECT_NEAR(m.penetration.fraction, static_cast<double>(x.size() - 1) / static_cast<double>(x.size()), 1e-9);
   // The centre is the deepest point: about the radius (the sphere mesh is a polygon).
   EXPECT_NEAR(m.penetration.max_depth_m, 0.3f, 0.01f);
+}
+
+// A flat square of cloth (20 x 20 cells, 6 cm wide) across the top of a 10 cm sphere, at height h.
+struct CapScene {
+  Mesh sphere = uv_sphere(0.1f, Vec3f::Zero(), 96, 48);
+  std::vector<Vec3f> cloth;
+  std::vector<Tri> triangles;
+  explicit CapScene(float h, float width = 0.06f) {
+    constexpr uint32_t n = 21;
+    for (uint32_t j = 0; j < n; ++j)
+      for (uint32_t i = 0; i < n; ++i)
+        cloth.emplace_back(width * (static_cast<float>(i) / (n - 1) - 0.5f), h, width * (static_cast<float>(j) / (n - 1) - 0.5f));
+    for (uint32_t j = 0; j + 1 < n; ++j)
+      for (uint32_t i = 0; i + 1 < n; ++i) {
+        const uint32_t a = j * n + i;
+        triangles.push_back({a, a + n, a + 1});
+        triangles.push_back({a + 1, a + n, a + n + 1});
+      }
+  }
+};
+
+TEST(SkinThrough, CapRisingThroughTheClothIsMeasured) {
+  // The cloth 3 mm below the sphere's top: the cap above it shows through, 3 mm at the pole.
+  const CapScene through(0.097f);
+  const SkinThroughStats s = measure_skin_through(through.sphere, through.cloth, through.triangles);
+  EXPECT_GT(s.body_vertices, 10u);
+  EXPECT_NEAR(s.max_depth_m, 0.003f, 0.0003f);
+  // 4 mm above it (where the collision keeps cloth vertices): nothing shows.
+  const CapScene above(0.104f);
+  EXPECT_EQ(measure_skin_through(above.sphere, above.cloth, above.triangles).body_vertices, 0u);
+  // 0.5 mm into the skin: within the 1 mm tolerance.
+  const CapScene grazing(0.0995f);
+  EXPECT_EQ(measure_skin_through(grazing.sphere, grazing.cloth, grazing.triangles).body_vertices, 0u);
+  // Skin the cloth does not cover: the same square moved 20 cm to the side, off the sphere.
+  CapScene beside(0.097f);
+  for (Vec3f& p : beside.cloth) p.x() += 0.2f;
+  EXPECT_EQ(measure_skin_through(beside.sphere, beside.cloth, beside.triangles).body_vertices, 0u);
 }
 
 TEST(MeasureGarment, NonFiniteStateIsReported) {

@@ -25,9 +25,9 @@ ImageCollider::ImageCollider(const Mesh& body, const BodyColliderOptions& option
   render_maps();
   if (bvh_) {
     // The tree answers only over hidden pixels (sample()), so the candidate grid lists only the
-    // cells above them: a fifth of the body's band or less, the rest of the grid's build time saved.
-    // A cell counts when its box, grown by a pixel for the rounding of cell and pixel indices,
-    // meets a hidden pixel.
+    // cells above them (on mean_all the grid's build 0.75 -> 0.51 s, 61 -> 46 MB with the maps:
+    // the side walls are hidden along their whole depth). A cell counts when its box, grown by a
+    // pixel for the rounding of cell and pixel indices, meets a hidden pixel.
     const float h = options_.pixel_size;
     bvh_->build_candidate_grid(TriangleBvh::kGridCell, TriangleBvh::kGridBand, [this, h](const Bounds& cell) {
       const int i0 = std::max(0, static_cast<int>(std::floor((cell.min.x() - origin_.x()) / h)) - 1);

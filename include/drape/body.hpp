@@ -139,6 +139,8 @@ Body default_body(Sex sex);
 // runs; bit for bit the body default_body returns when built with the same compiler and flags).
 // Other options (a finer grid) give the default body at another resolution.
 Body generate_default_body(Sex sex, const BodyBuildOptions& options = {});
+// The generator's last step, on the mesh it settled on (or that mesh baked): named, analysed, rigged.
+Body finish_generated_body(Sex sex, Mesh mesh);
 MeasurementRequest default_measurements(Sex sex);
 
 // ---- Bodies from files --------------------------------------------------------------------------

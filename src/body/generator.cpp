@@ -13,6 +13,7 @@
 #include <charconv>
 #include <limits>
 #include <cmath>
+#include <utility>
 #include <variant>
 
 #include "body/loft.hpp"
@@ -459,8 +460,7 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
     if (error.worst < 0.002f) break;
     correct(shape, r, given, m);
   }
-  Body body;
-  body.sex = sex;
+  Mesh best_mesh;
   shape = best_shape;
   best_error = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
   for (int pass = 0; pass < 2; ++pass) {
@@ -469,11 +469,18 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
     const FitError error = fit_error(given, m);
     if (error < best_error) {
       best_error = error;
-      body.mesh = std::move(mesh);
+      best_mesh = std::move(mesh);
     }
     if (error.worst < 0.004f) break;
     correct(shape, r, given, m);
   }
+  return finish_generated_body(sex, std::move(best_mesh));
+}
+
+Body finish_generated_body(Sex sex, Mesh mesh) {
+  Body body;
+  body.sex = sex;
+  body.mesh = std::move(mesh);
   body.mesh.name = "body";
   analyse_body(body, "generated body");
   rig_body(body);

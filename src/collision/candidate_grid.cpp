@@ -77,7 +77,6 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band, con
   const size_t chunks = (marked.size() + kChunk - 1) / kChunk;
   std::vector<std::vector<Candidate>> chunk_candidates(chunks);
   std::vector<uint32_t> count(cells, 0);
-  std::vector<size_t> listed(chunks, 0);
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::ptrdiff_t k = 0; k < static_cast<std::ptrdiff_t>(chunks); ++k) {
     std::vector<SurfaceHit> within;
@@ -136,10 +135,8 @@ CandidateGrid::CandidateGrid(const TriangleBvh& bvh, float cell, float band, con
                        static_cast<uint16_t>(std::min(units, 65535.0f))});
       }
       count[c] = static_cast<uint32_t>(out.size() - first);
-      listed[static_cast<size_t>(k)] += count[c] > 0;
     }
   }
-  for (size_t n : listed) listed_cells_ += n;
   first_.assign(cells + 1, 0);
   for (size_t c = 0; c < cells; ++c) first_[c + 1] = first_[c] + count[c];
   candidates_.reserve(first_[cells]);
@@ -211,6 +208,13 @@ CandidateGrid::Answer CandidateGrid::closest_in(size_t c, const Vec3f& p, float 
     }
   }
   return found ? Answer::kFound : Answer::kNone;
+}
+
+size_t CandidateGrid::listed_cells() const {
+  size_t lists = 0;
+  for (size_t c = 0; c + 1 < first_.size(); ++c)  // a cell left out holds only a truncation entry
+    lists += first_[c + 1] > first_[c] && candidates_[first_[c]].record() != kTruncated;
+  return lists;
 }
 
 double CandidateGrid::mean_list_length() const {

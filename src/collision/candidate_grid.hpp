@@ -62,7 +62,7 @@ class CandidateGrid {
     return first_.size() * sizeof(uint32_t) + candidates_.size() * sizeof(Candidate) + records_.size() * sizeof(Record);
   }
   double mean_list_length() const;
-  size_t listed_cells() const { return listed_cells_; }  // cells that got a list of their own
+  size_t listed_cells() const;  // cells with a list of their own (not left out by the filter)
 
  private:
   // A copy of one triangle's corners next to its id, in Morton order of the centroids: a cell's
@@ -99,7 +99,6 @@ class CandidateGrid {
   std::vector<Candidate> candidates_;
   std::vector<Record> records_;
   std::vector<uint32_t> record_of_;  // triangle -> its record
-  size_t listed_cells_ = 0;
 };
 
 }  // namespace drape::collision

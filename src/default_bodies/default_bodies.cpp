@@ -29,13 +29,7 @@ namespace drape {
 
 Body default_body(Sex sex) {
   const std::span<const unsigned char> bytes(drape_baked_bodies_begin, drape_baked_bodies_end);
-  Body body;
-  body.sex = sex;
-  body.mesh = body::decode_baked_body(bytes, sex);
-  body.mesh.name = "body";
-  analyse_body(body, "generated body");
-  rig_body(body);
-  return body;
+  return finish_generated_body(sex, body::decode_baked_body(bytes, sex));
 }
 
 }  // namespace drape

@@ -31,6 +31,7 @@ struct DressArgs {
   int threads = 0;
   uint64_t max_iterations = 0;
   float mass_scaling = DressOptions{}.mass_scaling;
+  float face_clearance = DressOptions{}.face_clearance;
   bool placement_only = false;
   std::string out = "out";
   LoadOptions load;
@@ -64,6 +65,8 @@ void run_dress(const DressArgs& a) {
   if (!(a.mass_scaling >= 0 && a.mass_scaling <= 1))
     throw InputError("--mass-scaling", "must be in [0, 1] (a fraction of the median particle's time step; 0: off)");
   o.mass_scaling = a.mass_scaling;
+  if (!(a.face_clearance <= 0.05)) throw InputError("--face-clearance", "must be at most 0.05 m (negative: off)");
+  o.face_clearance = a.face_clearance;
   o.simulate = !a.placement_only;
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
@@ -153,6 +156,11 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--mass-scaling", args->mass_scaling,
                   "particles whose stability bound is below this fraction of the median particle's get more inertia "
                   "(weight unchanged), for a longer time step; the state of rest is the same (0: off)")
+      ->capture_default_str();
+  cmd->add_option("--face-clearance", args->face_clearance,
+                  "while draping, keep the cloth's faces, not only its vertices, this many metres off the body where "
+                  "it curves under them (the particles are lifted by at most 6 mm), so the skin does not show "
+                  "through a coarse mesh; negative: off")
       ->capture_default_str();
   cmd->add_flag("--placement-only", args->placement_only,
                 "write the garments where placement put them, before sewing (fails the settled gate)");

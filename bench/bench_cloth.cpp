@@ -11,7 +11,8 @@
 // settings sew_and_drape uses while draping (4 velocity passes, 4 position passes, 128 converge
 // passes, the seams held). The shirt is sewn and draped for 1500 iterations first, so the step is a
 // step of a garment resting on the body with springs at the limit; the same 2000 steps are timed in
-// every run. Counters: microseconds per step per stage (wall). On 2026-11-21 the scale 4 shirt
+// every run; `faces` 1 keeps the faces off the body too (DressOptions::face_clearance, on while
+// draping), 0 only the vertices. Counters: microseconds per step per stage (wall). On 2026-11-21 the scale 4 shirt
 // exploded while sewing (as `drape dress --edge 0.013` did): the benchmark reports that as an error.
 #include <benchmark/benchmark.h>
 #include <omp.h>
@@ -72,6 +73,7 @@ BENCHMARK(BM_SphereStep)
 void BM_ShirtDrapeStep(benchmark::State& state) {
   const int scale = static_cast<int>(state.range(0));  // vertex count factor (edge length / sqrt)
   const int threads = static_cast<int>(state.range(1));
+  const bool faces = state.range(2) != 0;  // DressOptions::face_clearance, or off
   omp_set_num_threads(threads);
   const drape::Body body = drape::default_body(drape::Sex::Female);
   const std::unique_ptr<drape::BodyCollider> collider = drape::make_body_collider(body.mesh, drape::CollisionMethod::image);
@@ -93,6 +95,7 @@ void BM_ShirtDrapeStep(benchmark::State& state) {
   settings.air_damping = o.drape_damping;
   settings.converge_passes = 128;
   settings.joined_pairs = g.seam_pairs;
+  settings.face_clearance = faces ? o.face_clearance : -1.0f;
   drape::StepScratch scratch(g.model, 1);
   drape::StepProfile profile;
   for (auto _ : state) {
@@ -104,6 +107,7 @@ void BM_ShirtDrapeStep(benchmark::State& state) {
   const double steps = static_cast<double>(std::max<uint64_t>(profile.steps, 1));
   state.counters["vertices"] = static_cast<double>(g.model.particle_count());
   state.counters["threads"] = threads;
+  state.counters["faces"] = faces ? 1 : 0;
   state.counters["passes"] = static_cast<double>(profile.strain_passes) / steps;
   for (const auto stage : {drape::StepProfile::DetectContacts, drape::StepProfile::SpringForces,
                            drape::StepProfile::IntegrateVelocities, drape::StepProfile::LimitStrainVelocity,
@@ -113,8 +117,8 @@ void BM_ShirtDrapeStep(benchmark::State& state) {
 }
 
 BENCHMARK(BM_ShirtDrapeStep)
-    ->ArgNames({"scale", "threads"})
-    ->ArgsProduct({{1, 4}, {1, 2}})
+    ->ArgNames({"scale", "threads", "faces"})
+    ->ArgsProduct({{1, 4}, {1, 2}, {0, 1}})
     ->Unit(benchmark::kMicrosecond)
     ->Iterations(2000)  // the same 2000 steps from the same state in every run: comparable runs
     ->UseRealTime();

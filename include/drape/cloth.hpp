@@ -205,6 +205,14 @@ struct StepSettings {
   // proportional to the depth inside the collision thickness.
   CollisionResponse collision_response = CollisionResponse::Velocity;
   float max_speed = 50.0f;  // m/s; faster means the integration exploded
+  // Faces over curved bodies: contacts keep the cloth's vertices collision_thickness off a body,
+  // but the flat faces between them come nearer a convex part by the rise of the surface under
+  // them (the skin shows through a coarse mesh at the shoulders). >= 0: particles in contact are kept
+  // further off (by at most 6 mm) where the body's rise under their edges (structural and shear
+  // springs, measured at each edge's midpoint) would bring a face nearer the body than this (m; 0:
+  // faces may touch the skin, not pass it).
+  // Negative: off, vertices only.
+  float face_clearance = -1.0f;
 };
 // Settings with the fabric's strain threshold.
 StepSettings default_step_settings(const ClothModel& model);
@@ -252,6 +260,15 @@ class StepScratch {
   std::vector<Vec3f> converge_start;      // per particle: position before the converge passes
   std::vector<Vec3f> step_start;          // per particle: position before this step's position update
   std::vector<uint32_t> changed_in_pass;  // per particle: 1 + the strain pass that last changed it
+  // StepSettings::face_clearance, per structural and shear spring ("edge"): the lift its ends need
+  // (m), and the edges measured this step (index, midpoint, its contact).
+  struct FaceLift {
+    std::vector<float> lift;
+    std::vector<uint32_t> edge;
+    std::vector<Vec3f> midpoint;
+    std::vector<ContactSample> contact, contact_tmp;
+    std::vector<float> particle_lift;
+  } face_lift;
   size_t max_colliders = 0;
 };
 

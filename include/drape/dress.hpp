@@ -69,6 +69,11 @@ struct DressOptions {
   // limit, and the dress at 16x and the shirt at 16x on the 63.3k-triangle body do not settle.
   // 0: every garment starts from its placement.
   double coarse_edge = 0;
+  // Faces over curved parts while draping (StepSettings::face_clearance): where the body rises
+  // under the cloth's edges, its particles are kept further off, so that its faces stay this far
+  // (m) off the skin and the skin does not show through a coarse mesh (the default shirt's
+  // shoulders). Not while sewing: lifted panels kept seams open. Negative: off.
+  float face_clearance = 0.0f;
   // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
   uint64_t max_iterations = 0;
   // false: stop after placement (to inspect where the panels start); the run is not settled.

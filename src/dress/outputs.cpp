@@ -121,6 +121,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                        {"settle_window_s", o.settle_window_s},
                        {"max_iterations", o.max_iterations},
                        {"mass_scaling", o.mass_scaling},
+                       {"face_clearance_m", o.face_clearance},
                        {"penetration_tolerance_m", kPenetrationTolerance}};
   // Skin rising through the cloth between its vertices (drape/fit.hpp): reported, not gated.
   extra["skin_through_cloth"] = {{"body_vertices", r.quality.skin_through.body_vertices},

@@ -103,6 +103,19 @@ inline bool keep_out_of_contact(Vec3f& x, const Vec3f& normal, float plane, floa
   return true;
 }
 
+// An upper bound on how far a body surface rises above the straight cloth edge between two
+// particles in contact with it: the body points under them are p = x - distance * normal, and a
+// surface whose normal turns by theta between them rises at most (|p_b - p_a| / 2) tan(theta / 2)
+// above the chord's midpoint (a ridge halfway; a circular arc rises (|p_b - p_a| / 2) tan(theta / 4)).
+// A concave surface (normals turning towards each other) stays under the chord: 0. Cheap, so that
+// only the edges it cannot rule out are measured (a collider query at their midpoint).
+inline float rise_bound(const Vec3f& xa, float da, const Vec3f& na, const Vec3f& xb, float db, const Vec3f& nb) {
+  const Vec3f chord = (xb - db * nb) - (xa - da * na);
+  if ((nb - na).dot(chord) <= 0) return 0.0f;  // concave or flat
+  const float c = std::clamp(na.dot(nb), -1.0f, 1.0f);
+  return 0.5f * chord.norm() * std::sqrt((1.0f - c) / std::max(1.0f + c, 1e-6f));
+}
+
 // A joined pair (a sewn seam): both ends get their mass-weighted mean velocity plus the share of
 // -gap/dt that closes the gap at the end of the step (velocity pass), or both move to their
 // mass-weighted mean position (position pass). Momentum is kept. Returns true if it changed

@@ -25,6 +25,8 @@ struct StrainLimitResult {
 // contacts.cpp: nearest surface per particle over all colliders; responses.
 void update_colliders(std::span<Collider* const> colliders, double time);
 void detect_contacts(const StepContext& c, std::span<Collider* const> colliders);
+// StepSettings::face_clearance: contacts lowered where the body rises under the cloth's edges.
+void lift_over_curvature(const StepContext& c, std::span<Collider* const> colliders);
 uint64_t apply_contact_forces(const StepContext& c);
 // changed (optional, per particle): set to `mark` where the response changed a position or velocity.
 uint64_t respond_to_contacts(const StepContext& c, uint32_t* changed = nullptr, uint32_t mark = 0);

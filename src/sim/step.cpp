@@ -2,7 +2,8 @@
 // function in its own file (stages.hpp) and is timed into StepProfile.
 //
 //   update colliders      bodies move to t + dt (animation, soft tissue)
-//   detect contacts       nearest surface of every particle (drape::Collider)
+//   detect contacts       nearest surface of every particle (drape::Collider), lifted by the
+//                         body's curvature under the cloth's edges            [face_clearance]  
 //   spring forces         eq. 2 + damping along each spring
 //   integrate velocities  gather forces per particle, gravity, viscous damping, air drag; eq. 3
 //   contact forces        sec. 5 force response (animated bodies)          [Force response]
@@ -79,6 +80,13 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_speed.assign(blocks, 0.0f);
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
+  const size_t edges = model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size();
+  face_lift.lift.assign(edges, 0.0f);
+  face_lift.edge.assign(edges, 0u);
+  face_lift.midpoint.assign(edges, Vec3f::Zero());
+  face_lift.contact.assign(edges, ContactSample{});
+  face_lift.contact_tmp.assign(colliders > 1 ? edges : 0, ContactSample{});
+  face_lift.particle_lift.assign(model.particle_count(), 0.0f);
   converge_start.assign(model.particle_count(), Vec3f::Zero());
   step_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
@@ -117,6 +125,8 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.contact_plane.size() != model.particle_count() ||
       scratch.converge_start.size() != model.particle_count() ||
       scratch.step_start.size() != model.particle_count() ||
+      scratch.face_lift.lift.size() != model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size() ||
+      (colliders.size() > 1 && scratch.face_lift.contact_tmp.size() != scratch.face_lift.lift.size()) ||
       colliders.size() > std::max<size_t>(scratch.max_colliders, 1) ||
       (colliders.size() > 1 && scratch.contact_tmp.size() != model.particle_count()))
     throw std::invalid_argument("step: state or scratch was not made for this model and collider count");
@@ -130,6 +140,7 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
   sim::update_colliders(colliders, state.time + dt);
   clock.mark(StepProfile::UpdateColliders);
   sim::detect_contacts(c, colliders);
+  sim::lift_over_curvature(c, colliders);
   clock.mark(StepProfile::DetectContacts);
   sim::compute_spring_forces(c);
   clock.mark(StepProfile::SpringForces);

@@ -260,14 +260,15 @@ class StepScratch {
   std::vector<Vec3f> converge_start;      // per particle: position before the converge passes
   std::vector<Vec3f> step_start;          // per particle: position before this step's position update
   std::vector<uint32_t> changed_in_pass;  // per particle: 1 + the strain pass that last changed it
-  // StepSettings::face_clearance, per structural and shear spring ("edge"): the lift its ends need
-  // (m), and the edges measured this step (index, midpoint, its contact).
+  // StepSettings::face_clearance: the edges measured this step (spring index, midpoint, its
+  // contact; per block of edges, at the start of its range, block_measured of them), and per
+  // particle the lift its edges need and the lift it has, which is carried from step to step (it
+  // falls slowly: see lift_over_curvature).
   struct FaceLift {
-    std::vector<float> lift;
-    std::vector<uint32_t> edge;
+    std::vector<uint32_t> edge, block_measured;
     std::vector<Vec3f> midpoint;
     std::vector<ContactSample> contact, contact_tmp;
-    std::vector<float> particle_lift;
+    std::vector<float> need, lift;
   } face_lift;
   size_t max_colliders = 0;
 };

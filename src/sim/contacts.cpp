@@ -15,24 +15,20 @@ namespace {
 constexpr float kMaxFaceLift = 0.006f;
 constexpr float kFaceLiftFall = 0.01f;  // m/s
 
-// The nearest surface over all colliders for each point, in fixed chunks, concurrently (as
-// drape::Collider allows). `other` holds the second and later colliders' answers (points' size).
-void nearest_contacts(std::span<Collider* const> colliders, std::span<const Vec3f> x, float radius,
+// The nearest surface over all colliders for each point of one chunk. `other` holds the second
+// and later colliders' answers (the chunk's size).
+void nearest_in_chunk(std::span<Collider* const> colliders, std::span<const Vec3f> x, float radius,
                       std::span<ContactSample> nearest, std::span<ContactSample> other) {
-  parallel_blocks(x.size(), [&](size_t, size_t begin, size_t end) {
-    const size_t count = end - begin;
-    if (colliders.empty()) {
-      for (size_t i = begin; i < end; ++i)
-        nearest[i] = {std::numeric_limits<float>::infinity(), Vec3f::UnitY(), Vec3f::Zero()};
-      return;
-    }
-    colliders[0]->query(x.subspan(begin, count), radius, nearest.subspan(begin, count));
-    for (size_t k = 1; k < colliders.size(); ++k) {
-      colliders[k]->query(x.subspan(begin, count), radius, other.subspan(begin, count));
-      for (size_t i = begin; i < end; ++i)
-        if (other[i].distance < nearest[i].distance) nearest[i] = other[i];
-    }
-  });
+  if (colliders.empty()) {
+    for (ContactSample& s : nearest) s = {std::numeric_limits<float>::infinity(), Vec3f::UnitY(), Vec3f::Zero()};
+    return;
+  }
+  colliders[0]->query(x, radius, nearest);
+  for (size_t k = 1; k < colliders.size(); ++k) {
+    colliders[k]->query(x, radius, other);
+    for (size_t i = 0; i < x.size(); ++i)
+      if (other[i].distance < nearest[i].distance) nearest[i] = other[i];
+  }
 }
 
 }  // namespace
@@ -46,7 +42,13 @@ void detect_contacts(const StepContext& c, std::span<Collider* const> colliders)
   // with face_clearance, particles up to kMaxFaceLift further out may still be lifted into the layer.
   const float radius = c.model.fabric.collision_thickness + (c.settings.face_clearance >= 0 ? kMaxFaceLift : 0.0f) +
                        2.0f * c.dt * std::max(c.state.max_speed, 1.0f);
-  nearest_contacts(colliders, c.state.x, radius, c.scratch.contact, c.scratch.contact_tmp);
+  const std::span<const Vec3f> x(c.state.x);
+  const std::span<ContactSample> nearest(c.scratch.contact), other(c.scratch.contact_tmp);
+  parallel_blocks(x.size(), [&](size_t, size_t begin, size_t end) {
+    const size_t count = end - begin;
+    nearest_in_chunk(colliders, x.subspan(begin, count), radius, nearest.subspan(begin, count),
+                     colliders.size() > 1 ? other.subspan(begin, count) : other);
+  });
 }
 
 // Faces over curved parts (StepSettings::face_clearance). The response keeps each particle
@@ -54,13 +56,15 @@ void detect_contacts(const StepContext& c, std::span<Collider* const> colliders)
 // (a shoulder under a 2.6 cm grid) they come nearer the skin than their vertices by the rise of the
 // surface under each edge, and pass through it where that exceeds the thickness. The rise is
 // measured: the collider is asked for the distance of the edge's midpoint, and the rise is the mean
-// of its ends' distances less the midpoint's (rise_bound rules out the edges over flat or gently
-// curved skin without a query; structural and shear springs, so a grid cell's diagonals cover its
-// centre). Each particle in contact is kept further off by what its edges need for their
-// midpoints to stay face_clearance off, by lowering its contact's distance: every response after
-// this (velocity, position passes, forces) then keeps it that much further out, with nothing else
-// to change. Per edge in parallel, then gathered per particle in the model's incidence order (no
-// races, the same on any number of threads).
+// of its ends' distances less the midpoint's (rise_exceeds rules out, without a query, the edges
+// over flat or gently curved skin, most of them; structural and shear springs, so a grid cell's
+// diagonals cover its centre). Each particle in contact is kept further off by what its edges need
+// for their midpoints to stay face_clearance off, by lowering its contact's distance: every
+// response after this (velocity, position passes, forces) then keeps it that much further out,
+// with nothing else to change. The lift follows a rise at once but falls by at most kFaceLiftFall:
+// lifts measured afresh each step flickered as the particles moved (the default shirt never
+// settled). Edges are picked and measured per fixed block, and their lifts scattered on one thread
+// in spring order, so the result is the same on any number of threads.
 void lift_over_curvature(const StepContext& c, std::span<Collider* const> colliders) {
   const ClothModel& m = c.model;
   const SpringRange edges{m.range(SpringKind::Structural).begin, m.range(SpringKind::Shear).end};
@@ -74,44 +78,43 @@ void lift_over_curvature(const StepContext& c, std::span<Collider* const> collid
   const Vec3f* x = c.state.x.data();
   const uint32_t* sa = m.spring_a.data();
   const uint32_t* sb = m.spring_b.data();
-  // Edges whose rise may exceed `allowed`, in spring order, with their midpoints.
-  size_t count = 0;
-  for (uint32_t k = 0; k < edges.size(); ++k) {
-    f.lift[k] = 0.0f;
-    const uint32_t a = sa[edges.begin + k], b = sb[edges.begin + k];
-    const ContactSample& ca = contact[a];
-    const ContactSample& cb = contact[b];
-    if (!(ca.distance < reach && cb.distance < reach) ||
-        !(rise_bound(x[a], ca.distance, ca.normal, x[b], cb.distance, cb.normal) > allowed))
-      continue;
-    f.edge[count] = k;
-    f.midpoint[count] = 0.5f * (x[a] + x[b]);
-    ++count;
-  }
-  const std::span<const Vec3f> midpoints(f.midpoint.data(), count);
-  nearest_contacts(colliders, midpoints, reach, std::span(f.contact.data(), count), std::span(f.contact_tmp));
-  parallel_blocks(count, [&](size_t, size_t begin, size_t end) {
-    for (size_t q = begin; q < end; ++q) {
-      if (!(f.contact[q].distance < reach)) continue;
-      const uint32_t k = f.edge[q];
-      const float ends = 0.5f * (contact[sa[edges.begin + k]].distance + contact[sb[edges.begin + k]].distance);
-      f.lift[k] = ends - f.contact[q].distance - allowed;
+  // Per block of edges: the edges whose rise may exceed `allowed`, in spring order, with their
+  // midpoints, at the start of the block's range; then their midpoints' contacts.
+  const std::span<ContactSample> measured(f.contact), other(f.contact_tmp);
+  parallel_blocks(edges.size(), [&](size_t block, size_t begin, size_t end) {
+    size_t count = 0;
+    for (size_t k = begin; k < end; ++k) {
+      const uint32_t s = edges.begin + static_cast<uint32_t>(k);
+      const ContactSample& ca = contact[sa[s]];
+      const ContactSample& cb = contact[sb[s]];
+      if (!(ca.distance < reach && cb.distance < reach) ||
+          !rise_exceeds(x[sa[s]], ca.distance, ca.normal, x[sb[s]], cb.distance, cb.normal, allowed))
+        continue;
+      f.edge[begin + count] = s;
+      f.midpoint[begin + count] = 0.5f * (x[sa[s]] + x[sb[s]]);
+      ++count;
     }
+    f.block_measured[block] = static_cast<uint32_t>(count);
+    nearest_in_chunk(colliders, std::span<const Vec3f>(f.midpoint).subspan(begin, count), reach,
+                     measured.subspan(begin, count), colliders.size() > 1 ? other.subspan(begin, count) : other);
   });
-  const uint32_t* begin_of = m.incident_begin.data();
-  const uint32_t* spring = m.incident_spring.data();
+  // What each particle's edges need, on one thread in spring order.
+  float* need = f.need.data();
+  for (size_t block = 0; block < block_count(edges.size()); ++block)
+    for (size_t q = block * kBlock; q < block * kBlock + f.block_measured[block]; ++q) {
+      if (!(measured[q].distance < reach)) continue;
+      const uint32_t a = sa[f.edge[q]], b = sb[f.edge[q]];
+      const float lift = 0.5f * (contact[a].distance + contact[b].distance) - measured[q].distance - allowed;
+      need[a] = std::max(need[a], lift);
+      need[b] = std::max(need[b], lift);
+    }
+  float* lift = f.lift.data();
   const float fall = kFaceLiftFall * c.dt;
   parallel_blocks(m.particle_count(), [&](size_t, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
-      if (!(contact[i].distance < reach)) {
-        f.particle_lift[i] = 0.0f;
-        continue;
-      }
-      float most = 0;
-      for (uint32_t e = begin_of[i]; e < begin_of[i + 1]; ++e)
-        if (spring[e] >= edges.begin && spring[e] < edges.end) most = std::max(most, f.lift[spring[e] - edges.begin]);
-      f.particle_lift[i] = std::max(std::min(most, kMaxFaceLift), f.particle_lift[i] - fall);
-      contact[i].distance -= f.particle_lift[i];
+      lift[i] = contact[i].distance < reach ? std::max(std::min(need[i], kMaxFaceLift), lift[i] - fall) : 0.0f;
+      need[i] = 0.0f;
+      if (lift[i] > 0) contact[i].distance -= lift[i];
     }
   });
 }

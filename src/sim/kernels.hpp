@@ -103,17 +103,20 @@ inline bool keep_out_of_contact(Vec3f& x, const Vec3f& normal, float plane, floa
   return true;
 }
 
-// An upper bound on how far a body surface rises above the straight cloth edge between two
+// Whether a body surface may rise more than `allowed` above the straight cloth edge between two
 // particles in contact with it: the body points under them are p = x - distance * normal, and a
 // surface whose normal turns by theta between them rises at most (|p_b - p_a| / 2) tan(theta / 2)
 // above the chord's midpoint (a ridge halfway; a circular arc rises (|p_b - p_a| / 2) tan(theta / 4)).
-// A concave surface (normals turning towards each other) stays under the chord: 0. Cheap, so that
-// only the edges it cannot rule out are measured (a collider query at their midpoint).
-inline float rise_bound(const Vec3f& xa, float da, const Vec3f& na, const Vec3f& xb, float db, const Vec3f& nb) {
+// A concave surface (normals turning towards each other) stays under the chord. Squared, without
+// a root or a division: it runs on every edge in contact, to rule out the few that need a collider
+// query at their midpoint.
+inline bool rise_exceeds(const Vec3f& xa, float da, const Vec3f& na, const Vec3f& xb, float db, const Vec3f& nb,
+                         float allowed) {
   const Vec3f chord = (xb - db * nb) - (xa - da * na);
-  if ((nb - na).dot(chord) <= 0) return 0.0f;  // concave or flat
+  if ((nb - na).dot(chord) <= 0) return false;  // concave or flat
   const float c = std::clamp(na.dot(nb), -1.0f, 1.0f);
-  return 0.5f * chord.norm() * std::sqrt((1.0f - c) / std::max(1.0f + c, 1e-6f));
+  // (|chord| / 2)^2 tan^2(theta / 2) > allowed^2, with tan^2(theta / 2) = (1 - c) / (1 + c).
+  return 0.25f * chord.squaredNorm() * (1.0f - c) > allowed * allowed * (1.0f + c);
 }
 
 // A joined pair (a sewn seam): both ends get their mass-weighted mean velocity plus the share of

@@ -81,12 +81,13 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
   const size_t edges = model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size();
-  face_lift.lift.assign(edges, 0.0f);
   face_lift.edge.assign(edges, 0u);
+  face_lift.block_measured.assign(sim::block_count(edges), 0u);
   face_lift.midpoint.assign(edges, Vec3f::Zero());
   face_lift.contact.assign(edges, ContactSample{});
   face_lift.contact_tmp.assign(colliders > 1 ? edges : 0, ContactSample{});
-  face_lift.particle_lift.assign(model.particle_count(), 0.0f);
+  face_lift.need.assign(model.particle_count(), 0.0f);
+  face_lift.lift.assign(model.particle_count(), 0.0f);
   converge_start.assign(model.particle_count(), Vec3f::Zero());
   step_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
@@ -125,8 +126,9 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.contact_plane.size() != model.particle_count() ||
       scratch.converge_start.size() != model.particle_count() ||
       scratch.step_start.size() != model.particle_count() ||
-      scratch.face_lift.lift.size() != model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size() ||
-      (colliders.size() > 1 && scratch.face_lift.contact_tmp.size() != scratch.face_lift.lift.size()) ||
+      scratch.face_lift.lift.size() != model.particle_count() ||
+      scratch.face_lift.edge.size() != model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size() ||
+      (colliders.size() > 1 && scratch.face_lift.contact_tmp.size() != scratch.face_lift.edge.size()) ||
       colliders.size() > std::max<size_t>(scratch.max_colliders, 1) ||
       (colliders.size() > 1 && scratch.contact_tmp.size() != model.particle_count()))
     throw std::invalid_argument("step: state or scratch was not made for this model and collider count");

@@ -134,27 +134,32 @@ TEST(ContactForce, PushesOutProportionallyToDepthAndOnlyInside) {
   EXPECT_EQ(outside, Vec3f::Zero());
 }
 
-// rise_bound: over a circular arc (radius R, the ends' normals theta apart) the surface rises
-// R (1 - cos(theta / 2)) above the chord; the bound is the rise of a ridge halfway, never less. A
-// symmetric ridge rises exactly the bound; concave and flat surfaces give 0.
-TEST(RiseBound, BoundsAnArcAndIsExactForARidge) {
+// rise_exceeds: over a circular arc (radius R, the ends' normals theta apart) the surface rises
+// R (1 - cos(theta / 2)) above the chord, which the test must not rule out; the bound it tests is the
+// rise of a ridge halfway along the chord, R sin(theta / 2) tan(theta / 2). A symmetric ridge rises
+// exactly that; concave and flat surfaces never exceed anything.
+TEST(RiseExceeds, NeverRulesOutAnArcAndBoundsARidgeExactly) {
   constexpr float radius = 0.05f, height = 0.004f;  // particles 4 mm off a cylinder of 5 cm
   for (float theta : {0.1f, 0.5f, 1.0f, 2.0f}) {
     const Vec3f na(std::sin(-theta / 2), std::cos(theta / 2), 0), nb(std::sin(theta / 2), std::cos(theta / 2), 0);
-    const float bound = rise_bound((radius + height) * na, height, na, (radius + height) * nb, height, nb);
-    const float arc = radius * (1 - std::cos(theta / 2));
-    EXPECT_GE(bound, arc) << theta;
-    // A ridge halfway along the chord 2 R sin(theta / 2): ~2x the arc's rise for small angles.
-    EXPECT_NEAR(bound, radius * std::sin(theta / 2) * std::tan(theta / 2), 1e-6f) << theta;
+    const auto exceeds = [&](float allowed) {
+      return rise_exceeds((radius + height) * na, height, na, (radius + height) * nb, height, nb, allowed);
+    };
+    const float arc = radius * (1 - std::cos(theta / 2)), ridge = radius * std::sin(theta / 2) * std::tan(theta / 2);
+    EXPECT_TRUE(exceeds(0.99f * arc)) << theta;
+    EXPECT_TRUE(exceeds(0.99f * ridge)) << theta;
+    EXPECT_FALSE(exceeds(1.01f * ridge)) << theta;
   }
   // A ridge: two planes meeting at the origin, normals 90 degrees apart; the body points 2 cm down
   // either slope, so the ridge line rises 2 cm / sqrt(2) above their chord.
   const Vec3f na = Vec3f(-1, 1, 0).normalized(), nb = Vec3f(1, 1, 0).normalized();
   const Vec3f pa = 0.02f * Vec3f(-1, -1, 0).normalized(), pb = 0.02f * Vec3f(1, -1, 0).normalized();
-  EXPECT_NEAR(rise_bound(pa + height * na, height, na, pb + height * nb, height, nb), 0.02f / std::sqrt(2.0f), 1e-5f);
+  const float rise = 0.02f / std::sqrt(2.0f);
+  EXPECT_TRUE(rise_exceeds(pa + height * na, height, na, pb + height * nb, height, nb, 0.99f * rise));
+  EXPECT_FALSE(rise_exceeds(pa + height * na, height, na, pb + height * nb, height, nb, 1.01f * rise));
   // The same ridge turned into a valley (normals towards each other), and a plane.
-  EXPECT_EQ(rise_bound(-pb + height * nb, height, nb, -pa + height * na, height, na), 0.0f);
-  EXPECT_EQ(rise_bound(Vec3f(0, height, 0), height, Vec3f::UnitY(), Vec3f(0.03f, height, 0), height, Vec3f::UnitY()), 0.0f);
+  EXPECT_FALSE(rise_exceeds(-pb + height * nb, height, nb, -pa + height * na, height, na, 0.0f));
+  EXPECT_FALSE(rise_exceeds(Vec3f(0, height, 0), height, Vec3f::UnitY(), Vec3f(0.03f, height, 0), height, Vec3f::UnitY(), 0.0f));
 }
 
 }  // namespace

@@ -65,7 +65,7 @@ void run_dress(const DressArgs& a) {
   if (!(a.mass_scaling >= 0 && a.mass_scaling <= 1))
     throw InputError("--mass-scaling", "must be in [0, 1] (a fraction of the median particle's time step; 0: off)");
   o.mass_scaling = a.mass_scaling;
-  if (!(a.face_clearance <= 0.05)) throw InputError("--face-clearance", "must be at most 0.05 m (negative: off)");
+  if (!(a.face_clearance <= 0.01)) throw InputError("--face-clearance", "must be at most 0.01 m (negative: off)");
   o.face_clearance = a.face_clearance;
   o.simulate = !a.placement_only;
   if (a.threads > 0) omp_set_num_threads(a.threads);
@@ -159,8 +159,9 @@ void add_dress_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--face-clearance", args->face_clearance,
                   "while draping, keep the cloth's faces, not only its vertices, this many metres off the body where "
-                  "it curves under them (the particles are lifted by at most 6 mm), so the skin does not show "
-                  "through a coarse mesh; negative: off")
+                  "it curves under them (the particles are lifted by at most 6 mm; above the fabric's 4 mm "
+                  "collision thickness every particle in contact is lifted by the difference), so the skin does "
+                  "not show through a coarse mesh; negative: off")
       ->capture_default_str();
   cmd->add_flag("--placement-only", args->placement_only,
                 "write the garments where placement put them, before sewing (fails the settled gate)");

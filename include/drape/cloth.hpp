@@ -210,8 +210,8 @@ struct StepSettings {
   // them (the skin shows through a coarse mesh at the shoulders). >= 0: particles in contact are kept
   // further off (by at most 6 mm) where the body's rise under their edges (structural and shear
   // springs, measured at each edge's midpoint) would bring a face nearer the body than this (m; 0:
-  // faces may touch the skin, not pass it).
-  // Negative: off, vertices only.
+  // faces may touch the skin, not pass it; above the collision thickness every particle in contact
+  // is lifted by the difference as well). Negative: off, vertices only.
   float face_clearance = -1.0f;
 };
 // Settings with the fabric's strain threshold.

@@ -71,8 +71,10 @@ void lift_over_curvature(const StepContext& c, std::span<Collider* const> collid
   if (!(c.settings.face_clearance >= 0) || edges.size() == 0 || colliders.empty()) return;
   const float thickness = m.fabric.collision_thickness;
   // A rise up to `allowed` leaves the faces face_clearance off; contacts farther than `reach`
-  // cannot be lifted into the thickness layer.
-  const float allowed = std::max(thickness - c.settings.face_clearance, 0.0f), reach = thickness + kMaxFaceLift;
+  // cannot be lifted into the thickness layer. A clearance beyond the thickness (allowed < 0) lifts
+  // every particle in contact by the difference, and each convex edge by its rise on top.
+  const float allowed = thickness - c.settings.face_clearance, reach = thickness + kMaxFaceLift;
+  const float base = std::max(-allowed, 0.0f), filter = std::max(allowed, 0.0f);
   ContactSample* contact = c.scratch.contact.data();
   StepScratch::FaceLift& f = c.scratch.face_lift;
   const Vec3f* x = c.state.x.data();
@@ -88,7 +90,7 @@ void lift_over_curvature(const StepContext& c, std::span<Collider* const> collid
       const ContactSample& ca = contact[sa[s]];
       const ContactSample& cb = contact[sb[s]];
       if (!(ca.distance < reach && cb.distance < reach) ||
-          !rise_exceeds(x[sa[s]], ca.distance, ca.normal, x[sb[s]], cb.distance, cb.normal, allowed))
+          !rise_exceeds(x[sa[s]], ca.distance, ca.normal, x[sb[s]], cb.distance, cb.normal, filter))
         continue;
       f.edge[begin + count] = s;
       f.midpoint[begin + count] = 0.5f * (x[sa[s]] + x[sb[s]]);
@@ -100,6 +102,7 @@ void lift_over_curvature(const StepContext& c, std::span<Collider* const> collid
   });
   // What each particle's edges need, on one thread in spring order.
   float* need = f.need.data();
+  std::fill(f.need.begin(), f.need.end(), base);
   for (size_t block = 0; block < block_count(edges.size()); ++block)
     for (size_t q = block * kBlock; q < block * kBlock + f.block_measured[block]; ++q) {
       if (!(measured[q].distance < reach)) continue;
@@ -113,7 +116,6 @@ void lift_over_curvature(const StepContext& c, std::span<Collider* const> collid
   parallel_blocks(m.particle_count(), [&](size_t, size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
       lift[i] = contact[i].distance < reach ? std::max(std::min(need[i], kMaxFaceLift), lift[i] - fall) : 0.0f;
-      need[i] = 0.0f;
       if (lift[i] > 0) contact[i].distance -= lift[i];
     }
   });

@@ -158,6 +158,38 @@ TEST(SkinThrough, FaceClearanceLiftsCoarseClothOffASharpBar) {
   EXPECT_NEAR(lifted.x.front().y(), plain.x.front().y(), 0.01f);
 }
 
+// A clearance beyond the collision thickness lifts cloth lying on flat ground by the difference:
+// a small sheet dropped on a table rests 4 mm above it (the thickness) with the lift off, 6 mm with
+// face_clearance = 6 mm (flat, so no edge needs more).
+TEST(SkinThrough, FaceClearanceBeyondTheThicknessLiftsFlatCloth) {
+  BoxCollider table(Vec3f(0, -0.5f, 0), Vec3f(1, 0.5f, 1));
+  GridClothOptions o;
+  o.nx = o.ny = 10;
+  o.width = o.height = 0.2f;
+  o.origin = Vec3f(-0.1f, 0.005f, -0.1f);
+  const ClothModel model = grid_cloth(test_fabric(), o);
+  const auto rest_height = [&](float face_clearance) {
+    ClothState state = initial_state(model);
+    StepSettings settings = default_step_settings(model);
+    settings.air_damping = 10.0f;
+    settings.face_clearance = face_clearance;
+    StepScratch scratch(model, 1);
+    Collider* colliders[] = {&table};
+    while (state.time < 0.5) EXPECT_EQ(step(model, state, colliders, settings, scratch), StepStatus::Ok);
+    float lowest = 1, highest = -1;
+    for (const Vec3f& x : state.x) {
+      lowest = std::min(lowest, x.y());
+      highest = std::max(highest, x.y());
+    }
+    EXPECT_LT(highest - lowest, 1e-4f);
+    return lowest;
+  };
+  const float thickness = model.fabric.collision_thickness;
+  EXPECT_NEAR(rest_height(-1.0f), thickness, 1e-4f);
+  EXPECT_NEAR(rest_height(thickness), thickness, 1e-4f);
+  EXPECT_NEAR(rest_height(thickness + 0.002f), thickness + 0.002f, 1e-4f);
+}
+
 TEST(MeasureGarment, NonFiniteStateIsReported) {
   GridClothOptions o;
   o.nx = o.ny = 4;

@@ -3,7 +3,7 @@
 //
 //   update colliders      bodies move to t + dt (animation, soft tissue)
 //   detect contacts       nearest surface of every particle (drape::Collider), lifted by the
-//                         body's curvature under the cloth's edges            [face_clearance]  
+//                         body's curvature under the cloth's edges            [face_clearance]
 //   spring forces         eq. 2 + damping along each spring
 //   integrate velocities  gather forces per particle, gravity, viscous damping, air drag; eq. 3
 //   contact forces        sec. 5 force response (animated bodies)          [Force response]

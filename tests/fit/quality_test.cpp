@@ -101,6 +101,23 @@ TEST(SkinThrough, CapRisingThroughTheClothIsMeasured) {
   EXPECT_EQ(measure_skin_through(beside.sphere, beside.cloth, beside.triangles).body_vertices, 0u);
 }
 
+// Damped settings for cloth coming to rest, with the faces kept `face_clearance` off (negative: off).
+StepSettings settling_settings(const ClothModel& model, float face_clearance) {
+  StepSettings settings = default_step_settings(model);
+  settings.air_damping = 10.0f;
+  settings.face_clearance = face_clearance;
+  return settings;
+}
+
+// The model from its rest layout against one collider for `seconds`, every step healthy.
+ClothState run_from_rest(const ClothModel& model, Collider& collider, const StepSettings& settings, double seconds) {
+  ClothState state = initial_state(model);
+  StepScratch scratch(model, 1);
+  Collider* colliders[] = {&collider};
+  while (state.time < seconds) EXPECT_EQ(step(model, state, colliders, settings, scratch), StepStatus::Ok);
+  return state;
+}
+
 // A coarse cloth (3 cm cells) hung over a thin bar (1.5 cm radius, along x), as a shirt's grid hangs
 // over a shoulder, its two middle rows 1.5 cm either side of the bar's top. Keeping the vertices
 // 4 mm off the bar is not enough: the cells across the top cut 3 mm into it. With
@@ -132,16 +149,10 @@ TEST(SkinThrough, FaceClearanceLiftsCoarseClothOffASharpBar) {
   o.origin = Vec3f(-0.105f, 0.025f, -0.105f);
   const ClothModel model = grid_cloth(test_fabric(), o);
   const auto drape_over_bar = [&](float face_clearance) {
-    ClothState state = initial_state(model);
-    StepSettings settings = default_step_settings(model);
+    StepSettings settings = settling_settings(model, face_clearance);
     settings.position_passes = 4;
     settings.converge_passes = 128;
-    settings.air_damping = 10.0f;
-    settings.face_clearance = face_clearance;
-    StepScratch scratch(model, 1);
-    Collider* colliders[] = {&bar};
-    while (state.time < 1.5) EXPECT_EQ(step(model, state, colliders, settings, scratch), StepStatus::Ok);
-    return state;
+    return run_from_rest(model, bar, settings, 1.5);
   };
   const ClothState plain = drape_over_bar(-1.0f);
   const SkinThroughStats through = measure_skin_through(bar_mesh, plain.x, model.triangles);
@@ -169,13 +180,7 @@ TEST(SkinThrough, FaceClearanceBeyondTheThicknessLiftsFlatCloth) {
   o.origin = Vec3f(-0.1f, 0.005f, -0.1f);
   const ClothModel model = grid_cloth(test_fabric(), o);
   const auto rest_height = [&](float face_clearance) {
-    ClothState state = initial_state(model);
-    StepSettings settings = default_step_settings(model);
-    settings.air_damping = 10.0f;
-    settings.face_clearance = face_clearance;
-    StepScratch scratch(model, 1);
-    Collider* colliders[] = {&table};
-    while (state.time < 0.5) EXPECT_EQ(step(model, state, colliders, settings, scratch), StepStatus::Ok);
+    const ClothState state = run_from_rest(model, table, settling_settings(model, face_clearance), 0.5);
     float lowest = 1, highest = -1;
     for (const Vec3f& x : state.x) {
       lowest = std::min(lowest, x.y());

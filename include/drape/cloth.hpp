@@ -189,6 +189,11 @@ struct StepSettings {
   // corrections also change the velocities by the displacement over the step (dx / dt), so use them
   // where corrections are small (draping), not where seams pull panels far past the limit.
   int converge_passes = 0;
+  // Before the converge passes: at most this many Newton iterations of a global projection of the
+  // springs over the limit back to it (0: none; see limit_strain_position). Each solves the
+  // linearised constraints of all of them together by conjugate gradients, so a ring converges in
+  // tens of cheap iterations over its few hundred springs instead of hundreds of Gauss-Seidel passes.
+  int projection_iterations = 0;
   // Viscous damping -gamma m v (1/s, sec. 2.2); negative: the fabric's air_damping. Quasi-static
   // draping raises it: the rest shape does not depend on it, only how fast the cloth gets there.
   float air_damping = -1.0f;
@@ -270,6 +275,18 @@ class StepScratch {
     std::vector<ContactSample> contact, contact_tmp;
     std::vector<float> need, lift;
   } face_lift;
+  // The converge passes' global projection (strain_limit.cpp, project_to_limit): per particle its
+  // node (the particles of joined pairs are one) and the node's inverse mass; per constraint row
+  // (a spring at the limit) its nodes, direction and right-hand side, and the conjugate-gradient
+  // vectors; per node the rows gathered (J^T v). Room for every strain-limited spring.
+  struct Projection {
+    std::vector<uint32_t> node, a, b, seam_row;
+    std::vector<uint8_t> merged;
+    std::vector<float> node_inverse_mass;
+    std::vector<Vec3f> direction;
+    std::vector<float> rhs, lambda, residual, search, product, diagonal;
+    std::vector<Vec3f> gathered;
+  } projection;
   size_t max_colliders = 0;
 };
 

@@ -26,6 +26,7 @@ namespace drape {
 namespace {
 
 constexpr int kConvergePasses = 128;  // StepSettings::converge_passes while draping
+constexpr int kProjectionIterations = 8;  // StepSettings::projection_iterations while draping
 constexpr float kRelaxAbove = 0.01f;  // strain over the limit after sewing that is relaxed before draping
 constexpr int kRelaxPasses = 1000;    // at most, Gauss-Seidel position passes (a pass is ~20 us per 1000 springs)
 
@@ -152,6 +153,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   // still near the limit until none is over it (skirt: 7.5 % -> 5.1 % max strain at a 5 % threshold).
   // Not while sewing: there the seams must be able to pull the cloth past the limit for a moment.
   settings.converge_passes = kConvergePasses;
+  settings.projection_iterations = kProjectionIterations;
   const Vec3f before = centre_of_mass(g.model, g.state.x);
   const double drape_start = g.state.time;
   // Settle windows: positions at the start of the current window (allocated once).

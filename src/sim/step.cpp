@@ -88,6 +88,18 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   face_lift.contact_tmp.assign(colliders > 1 ? edges : 0, ContactSample{});
   face_lift.need.assign(model.particle_count(), 0.0f);
   face_lift.lift.assign(model.particle_count(), 0.0f);
+  const size_t rows = model.limit_a.size();
+  projection.node.assign(model.particle_count(), 0u);
+  projection.node_inverse_mass.assign(model.particle_count(), 0.0f);
+  projection.merged.assign(model.particle_count(), 0u);
+  projection.seam_row.assign(rows, 0u);
+  projection.a.assign(rows, 0u);
+  projection.b.assign(rows, 0u);
+  projection.direction.assign(rows, Vec3f::Zero());
+  for (auto* v : {&projection.rhs, &projection.lambda, &projection.residual, &projection.search, &projection.product,
+                  &projection.diagonal})
+    v->assign(rows, 0.0f);
+  projection.gathered.assign(model.particle_count(), Vec3f::Zero());
   converge_start.assign(model.particle_count(), Vec3f::Zero());
   step_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
@@ -125,6 +137,8 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.changed_in_pass.size() != model.particle_count() ||
       scratch.contact_plane.size() != model.particle_count() ||
       scratch.converge_start.size() != model.particle_count() ||
+      scratch.projection.gathered.size() != model.particle_count() ||
+      scratch.projection.a.size() != model.limit_a.size() ||
       scratch.step_start.size() != model.particle_count() ||
       scratch.face_lift.lift.size() != model.particle_count() ||
       scratch.face_lift.edge.size() != model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size() ||

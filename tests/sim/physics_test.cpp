@@ -150,6 +150,18 @@ TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
   EXPECT_LT(ring_strain(256), threshold + 0.001f);
 }
 
+// Settings for the ring tests: no gravity, 4 position passes, 128 converge passes, the projection's
+// iterations as given.
+StepSettings ring_settings(const ClothModel& model, float threshold, int projection_iterations) {
+  StepSettings settings = default_step_settings(model);
+  settings.strain_threshold = threshold;
+  settings.gravity = Vec3f::Zero();
+  settings.position_passes = 4;
+  settings.converge_passes = 128;
+  settings.projection_iterations = projection_iterations;
+  return settings;
+}
+
 // A waistband of 120 springs, 0.5 % over the limit and still being pulled wide, in two halves sewn together
 // at two side seams (each seam a joined pair: two particles at one place, as the dressing pipeline
 // holds its seams). Gauss-Seidel shrinks a ring of n springs at ~(pi/n)^2 per pass, so 128 converge
@@ -177,12 +189,7 @@ TEST(ClothPhysics, ProjectionPullsALongSewnRingBackWhereGaussSeidelCannot) {
     ClothState state = initial_state(model);
     for (size_t i = 0; i < state.x.size(); ++i)
       state.v[i] = 0.5f * Vec3f(state.x[i].x(), 0, state.x[i].z()).normalized();
-    StepSettings settings = default_step_settings(model);
-    settings.strain_threshold = threshold;
-    settings.gravity = Vec3f::Zero();
-    settings.position_passes = 4;
-    settings.converge_passes = 128;
-    settings.projection_iterations = projection_iterations;
+    StepSettings settings = ring_settings(model, threshold, projection_iterations);
     settings.joined_pairs = seams;
     StepScratch scratch(model);
     EXPECT_EQ(step(model, state, {}, settings, scratch, &profile), StepStatus::Ok);
@@ -216,12 +223,7 @@ TEST(ClothPhysics, RingTooSmallForAPostComesToRestOnIt) {
   for (int projection_iterations : {0, 8}) {
     SCOPED_TRACE(projection_iterations ? "with the projection" : "Gauss-Seidel passes only");
     ClothState state = initial_state(model);
-    StepSettings settings = default_step_settings(model);
-    settings.strain_threshold = threshold;
-    settings.gravity = Vec3f::Zero();
-    settings.position_passes = 4;
-    settings.converge_passes = 128;
-    settings.projection_iterations = projection_iterations;
+    const StepSettings settings = ring_settings(model, threshold, projection_iterations);
     StepScratch scratch(model, 1);
     for (int k = 0; k < 400; ++k) ASSERT_EQ(step(model, state, colliders, settings, scratch), StepStatus::Ok);
     const float thickness = model.fabric.collision_thickness;

@@ -194,6 +194,13 @@ struct StepSettings {
   // linearised constraints of all of them together by conjugate gradients, so a ring converges in
   // tens of cheap iterations over its few hundred springs instead of hundreds of Gauss-Seidel passes.
   int projection_iterations = 0;
+  // In the converge passes a joined pair counts as a correction (one that keeps the passes going)
+  // only when open by more than this (m; it is held whenever open by more than 0.01 mm). Where a
+  // seam crosses a band on the hips, the pair's two particles have their own contact planes: holding
+  // them together and keeping each out of the body opened them by 0.01-0.05 mm again on every pass,
+  // so the passes never found nothing to correct and ran to their cap on every draping step (the
+  // trousers: 3-9 such pairs a pass). 0: any pair held counts.
+  float converge_pair_tolerance = 0.0f;
   // Viscous damping -gamma m v (1/s, sec. 2.2); negative: the fabric's air_damping. Quasi-static
   // draping raises it: the rest shape does not depend on it, only how fast the cloth gets there.
   float air_damping = -1.0f;
@@ -286,6 +293,7 @@ class StepScratch {
     std::vector<Vec3f> direction;
     std::vector<float> rhs, lambda, residual, search, product, diagonal;
     std::vector<Vec3f> gathered;
+    std::vector<Vec3f> saved;  // per particle: positions before the current iteration
   } projection;
   size_t max_colliders = 0;
 };

@@ -26,7 +26,7 @@ namespace drape {
 namespace {
 
 constexpr int kConvergePasses = 128;  // StepSettings::converge_passes while draping
-constexpr int kProjectionIterations = 8;  // StepSettings::projection_iterations while draping
+constexpr float kConvergePairTolerance = 5e-5f;  // m, StepSettings::converge_pair_tolerance once seamed
 constexpr float kRelaxAbove = 0.01f;  // strain over the limit after sewing that is relaxed before draping
 constexpr int kRelaxPasses = 1000;    // at most, Gauss-Seidel position passes (a pass is ~20 us per 1000 springs)
 
@@ -143,17 +143,23 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   settings.gravity = Vec3f(0.0f, -9.81f, 0.0f);
   settings.friction = -1.0f;
   settings.air_damping = o.drape_damping;
-  // Faces over curved parts (DressOptions::face_clearance) once the garment is seamed: lifting the
-  // cloth off the body where seams still close pushed them apart (jeans S on the average female
-  // MakeHuman body, sewn with its inseams 13 mm open at the crotch, kept them open).
-  const auto lift_faces_once_seamed = [&](bool seamed) { settings.face_clearance = seamed ? o.face_clearance : -1.0f; };
-  lift_faces_once_seamed(g.seams_closed);
+  // What waits until the garment is seamed, because a pair still closing must be able to pull the
+  // cloth: the faces over curved parts (DressOptions::face_clearance: lifting the cloth off the body
+  // pushed the seams apart), and the converge passes' looser count of held pairs
+  // (StepSettings::converge_pair_tolerance: with it the pair closed no more). Jeans S on the
+  // average female MakeHuman body, sewn with its inseams 13-15 mm open at the crotch, kept them
+  // open with either from the start of draping.
+  const auto once_seamed = [&](bool seamed) {
+    settings.face_clearance = seamed ? o.face_clearance : -1.0f;
+    settings.converge_pair_tolerance = seamed ? kConvergePairTolerance : 0.0f;
+  };
+  once_seamed(g.seams_closed);
   // A waistband hangs on the hips by its hoop tension, which the strain limit must hold, and a ring
   // of springs converges slowly under Gauss-Seidel: continue the position passes over the springs
   // still near the limit until none is over it (skirt: 7.5 % -> 5.1 % max strain at a 5 % threshold).
   // Not while sewing: there the seams must be able to pull the cloth past the limit for a moment.
   settings.converge_passes = kConvergePasses;
-  settings.projection_iterations = kProjectionIterations;
+  settings.projection_iterations = o.projection_iterations;
   const Vec3f before = centre_of_mass(g.model, g.state.x);
   const double drape_start = g.state.time;
   // Settle windows: positions at the start of the current window (allocated once).
@@ -164,7 +170,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     g.status = step(g.model, g.state, colliders, settings, scratch, &g.profile);
     if (g.status != StepStatus::Ok) break;
     limit_seams(g.model, g.state, g.seam_pairs, dt);
-    lift_faces_once_seamed(join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m));
+    once_seamed(join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m));
     settings.joined_pairs = held;
     if (g.state.time - window_began >= o.settle_window_s) {
       float moved2 = 0;

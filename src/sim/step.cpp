@@ -100,6 +100,7 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
                   &projection.diagonal})
     v->assign(rows, 0.0f);
   projection.gathered.assign(model.particle_count(), Vec3f::Zero());
+  projection.saved.assign(model.particle_count(), Vec3f::Zero());
   converge_start.assign(model.particle_count(), Vec3f::Zero());
   step_start.assign(model.particle_count(), Vec3f::Zero());
   changed_in_pass.assign(model.particle_count(), 0u);
@@ -138,6 +139,7 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.contact_plane.size() != model.particle_count() ||
       scratch.converge_start.size() != model.particle_count() ||
       scratch.projection.gathered.size() != model.particle_count() ||
+      scratch.projection.saved.size() != model.particle_count() ||
       scratch.projection.a.size() != model.limit_a.size() ||
       scratch.step_start.size() != model.particle_count() ||
       scratch.face_lift.lift.size() != model.particle_count() ||

@@ -18,6 +18,7 @@
 // (StepSettings::converge_passes).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/kernels.hpp"
 #include "sim/parallel.hpp"
@@ -114,12 +115,6 @@ namespace {
 // Done when no spring is over the limit by more than 0.1 % strain (the regular passes' 0.01 %
 // kept the trousers' hips, where contacts push back, at the pass cap: 16 % more time).
 constexpr float kConvergeTolerance = 1e-3f;
-// In the converge passes a joined pair counts as a correction only when open by more than this
-// (it is still held from kJoinedTolerance). Where a seam crosses a band on the hips, the pair's two
-// particles have their own contact planes: holding them together and keeping each out of the body
-// opened them by 0.01-0.05 mm again on every pass, so the passes never found nothing to correct and
-// ran to their cap of 128 on every draping step (the trousers: 3-9 such pairs a pass).
-constexpr float kConvergePairTolerance = 5e-5f;  // m
 
 // The contacts of this step as seen by the position passes: each particle's tangent plane
 // (StepScratch::contact_plane, written by integrate_positions). A correction that pulls a particle
@@ -248,9 +243,12 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
     return sum;
   };
   int run = 0;
+  double previous_residual = std::numeric_limits<double>::infinity();
+  Vec3f* saved = p.saved.data();
   for (; run < iterations; ++run) {
     size_t n = 0, seam_rows = 0;
     bool over_tolerance = false;
+    double residual = 0;  // sum of the squared strains over the limit
     for (size_t s = 0; s < m.limit_a.size(); ++s) {
       const uint32_t a = node[m.limit_a[s]], b = node[m.limit_b[s]];
       const float limit = stretch * m.limit_rest[s], near = limit - kProjectNear * m.limit_rest[s];
@@ -258,8 +256,9 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
       const float len2 = d.squaredNorm();
       if (a == b || !(len2 > near * near) || w[a] + w[b] <= 0) continue;
       const float len = std::sqrt(len2);
+      if (len > limit) residual += double((len - limit) / m.limit_rest[s]) * double((len - limit) / m.limit_rest[s]);
       // Springs along a seam on both of its panels join the same two nodes: one row for them (the
-      // longest limit's excess... the first in spring order), or the system is singular there.
+      // first in spring order), or the system is singular there.
       if (merged[a] && merged[b]) {
         bool duplicate = false;
         for (size_t k = 0; k < seam_rows && !duplicate; ++k) {
@@ -277,6 +276,15 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
       ++n;
     }
     if (!over_tolerance) break;
+    // An iteration that did not lower the residual is undone, and the projection ends there: the
+    // Gauss-Seidel passes go on from the best state it reached (without this the dress and the skirt
+    // at 4x Table 2's resolution, whose loose solves overshot, never settled).
+    if (residual >= previous_residual) {
+      std::copy(saved, saved + particles, x);
+      break;
+    }
+    previous_residual = residual;
+    std::copy(x, x + particles, saved);
     // Preconditioned conjugate gradients on (J W J^T) lambda = C, from lambda = 0.
     float* lambda = p.lambda.data();
     float* r = p.residual.data();
@@ -365,11 +373,12 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
   size_t count = 0;
   const auto limit = position_limit(c, kConvergeTolerance, contacts, /*keep_out_always=*/true);
   const auto correct = [&](uint32_t s) { return limit(s) == Change::Corrected ? 1u : 0u; };
+  const float pair_tolerance = std::max(c.settings.converge_pair_tolerance, kJoinedTolerance);
   for (int pass = 0; pass < converge_passes; ++pass) {
-    // What Gauss-Seidel has not finished in kProjectAfter passes is a ring or a wide region at the
-    // limit: projected as a whole, then the passes go on from there. Projecting first (or after 4
-    // or 8 passes) left the dress at Table 2's resolution unsettled after 5 s (bench_dress
-    // Table2/dress/x1); after 16 every Table 2 x1 row passes every gate.
+    // What Gauss-Seidel has not finished in kProjectAfter passes (a ring held at the limit) is
+    // projected as a whole, then the passes go on from there. Projecting before any pass (or after
+    // 4 or 8) left the dress at Table 2's resolution unsettled after 5 s; see docs/cloth.md for what
+    // it does at 4x.
     const bool project = pass == kProjectAfter && c.settings.projection_iterations > 0;
     if (project)
       result.passes += static_cast<uint32_t>(project_to_limit(c, contacts, kConvergeTolerance, c.settings.projection_iterations));
@@ -387,7 +396,7 @@ StrainLimitResult limit_strain_position(const StepContext& c, int max_passes, in
       for (size_t k = count; k-- > 0;) corrections += correct(active[k]);
     }
     for (const auto& [a, b] : c.settings.joined_pairs) {
-      const bool counts = (x[a] - x[b]).squaredNorm() > kConvergePairTolerance * kConvergePairTolerance;
+      const bool counts = (x[a] - x[b]).squaredNorm() > pair_tolerance * pair_tolerance;
       if (!hold(a, b)) continue;
       corrections += counts ? 1u : 0u;
       contacts.keep_out(x, a);

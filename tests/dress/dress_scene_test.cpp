@@ -336,7 +336,7 @@ constexpr const char* kMaleThin = "makehuman/derived/mh_male_thin.obj";
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSize,
                          ::testing::Values(SharedFit{"dress", kMeanAll, "XL"}, SharedFit{"trousers", kMeanAll, "XL"},
                                            SharedFit{"shirt", kFemaleAverage, "S"}, SharedFit{"dress", kFemaleAverage, "S"},
-                                           SharedFit{"skirt", kFemaleAverage, "S"},
+                                           SharedFit{"skirt", kFemaleAverage, "S"}, SharedFit{"jeans", kFemaleAverage, "S"},
                                            SharedFit{"shirt", kFemaleHeavy, "S"}, SharedFit{"dress", kFemaleHeavy, "S"},
                                            SharedFit{"skirt", kFemaleHeavy, "M"}, SharedFit{"trousers", kFemaleHeavy, "M"},
                                            SharedFit{"skirt", kMaleAverage, "M"}, SharedFit{"trousers", kMaleThin, "XS"},
@@ -353,11 +353,7 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSize,
 // is too small for her; L passes, JeansLOnHeavyFemaleBody); trousers M on the average
 // male MakeHuman body (waist 0.75 m, hips 0.94 m: M slides 0.20 m; eight men's sizes for him
 // graded like XS, waist 0.84-0.91 m, 4-11 cm lower, hips 1.02-1.05 m, either slid 0.16-0.20 m or
-// left an outseam's top corner 20-42 mm open); jeans S on the average female MakeHuman body (since
-// the converge passes' projection, a9f520e and after: its sewing runs out of time with a pair
-// open and, draped, the crotch keeps 14.6 mm open; it closed while draping before, and does with
-// the projection after 0, 4 or 8 passes instead of 16, but then the dress at Table 2's resolution
-// does not settle; the same case failed the Chebyshev probe, docs/dressing.md).
+// left an outseam's top corner 20-42 mm open).
 class SharedBodyOwnSizeNotYet : public SharedBodyOwnSize {};
 TEST_P(SharedBodyOwnSizeNotYet, DISABLED_PassesTheGates) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
@@ -366,8 +362,7 @@ TEST_P(SharedBodyOwnSizeNotYet, DISABLED_PassesTheGates) {
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSizeNotYet,
                          ::testing::Values(SharedFit{"jeans", kMeanAll, "XL"}, SharedFit{"jeans", kFemaleHeavy, "M"},
-                                           SharedFit{"trousers", kMaleAverage, "M"},
-                                           SharedFit{"jeans", kFemaleAverage, "S"}),
+                                           SharedFit{"trousers", kMaleAverage, "M"}),
                          shared_fit_name);
 
 // The heavy female body (upper arm 0.30 m) wears the shirt's L: in M a sleeve's armhole corner

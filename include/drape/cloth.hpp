@@ -189,10 +189,11 @@ struct StepSettings {
   // corrections also change the velocities by the displacement over the step (dx / dt), so use them
   // where corrections are small (draping), not where seams pull panels far past the limit.
   int converge_passes = 0;
-  // Before the converge passes: at most this many Newton iterations of a global projection of the
-  // springs over the limit back to it (0: none; see limit_strain_position). Each solves the
-  // linearised constraints of all of them together by conjugate gradients, so a ring converges in
-  // tens of cheap iterations over its few hundred springs instead of hundreds of Gauss-Seidel passes.
+  // After 16 converge passes that have not finished: at most this many Newton iterations of a
+  // global projection of the springs at the limit back to it (0: none; project_to_limit in
+  // strain_limit.cpp). Each solves the linearised constraints of all of them together by conjugate
+  // gradients, so a ring converges in a few iterations over its few hundred springs where
+  // Gauss-Seidel passes stall.
   int projection_iterations = 0;
   // In the converge passes a joined pair counts as a correction (one that keeps the passes going)
   // only when open by more than this (m; it is held whenever open by more than 0.01 mm). Where a

@@ -190,7 +190,7 @@ auto position_hold(const StepContext& c) {
 // Returns the iterations run.
 int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float tolerance, int iterations) {
   constexpr int kCgIterations = 64;
-  constexpr double kCgRelativeResidual = 0.1;  // of the right-hand side: the next iteration corrects the rest  // of the right-hand side: the next iteration corrects the rest
+  constexpr double kCgRelativeResidual = 0.1;  // of the right-hand side: the next iteration corrects the rest
   constexpr float kProjectNear = 0.002f;        // strain below the limit that joins the set, held at its length
   constexpr float kMaxMove = 0.002f;  // m: no particle moves further in one iteration (a safeguard)
   const ClothModel& m = c.model;
@@ -226,8 +226,7 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
   for (size_t i = 0; i < particles; ++i)
     if (node[i] != i) merged[node[i]] = 1;
   Vec3f* g = p.gathered.data();
-  // y = (J W J^T) v, with a Levenberg-Marquardt term (kDamp of the diagonal): gather J^T v per node,
-  // then each row's gradient . W (J^T v).
+  // y = (J W J^T) v: gather J^T v per node, then each row's gradient . W (J^T v).
   const auto multiply = [&](size_t n, const float* v, float* y) {
     for (size_t k = 0; k < n; ++k) g[p.a[k]] = g[p.b[k]] = Vec3f::Zero();
     for (size_t k = 0; k < n; ++k) {
@@ -277,8 +276,8 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
     }
     if (!over_tolerance) break;
     // An iteration that did not lower the residual is undone, and the projection ends there: the
-    // Gauss-Seidel passes go on from the best state it reached (without this the dress and the skirt
-    // at 4x Table 2's resolution, whose loose solves overshot, never settled).
+    // Gauss-Seidel passes go on from the best state it reached (without this the skirt at 4x Table
+    // 2's resolution, whose loose solves overshot, did not settle with the projection on).
     if (residual >= previous_residual) {
       std::copy(saved, saved + particles, x);
       break;

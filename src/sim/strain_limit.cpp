@@ -227,13 +227,16 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
     if (node[i] != i) merged[node[i]] = 1;
   Vec3f* g = p.gathered.data();
   // y = (J W J^T) v: gather J^T v per node, then each row's gradient . W (J^T v).
-  const auto multiply = [&](size_t n, const float* v, float* y) {
+  const auto gather = [&](size_t n, const float* v) {
     for (size_t k = 0; k < n; ++k) g[p.a[k]] = g[p.b[k]] = Vec3f::Zero();
     for (size_t k = 0; k < n; ++k) {
       const Vec3f d = p.direction[k] * v[k];
       g[p.a[k]] -= d;
       g[p.b[k]] += d;
     }
+  };
+  const auto multiply = [&](size_t n, const float* v, float* y) {
+    gather(n, v);
     for (size_t k = 0; k < n; ++k) y[k] = p.direction[k].dot(w[p.b[k]] * g[p.b[k]] - w[p.a[k]] * g[p.a[k]]);
   };
   const auto dot = [](size_t n, const float* u, const float* v) {
@@ -316,10 +319,10 @@ int project_to_limit(const StepContext& c, const ContactPlanes& contacts, float 
       for (size_t k = 0; k < n; ++k) q[k] = r[k] / diagonal[k] + beta * q[k];
     }
     // dx = -W J^T lambda, the same for every particle of a node.
-    multiply(n, lambda, aq);  // gathers J^T lambda into g (the product itself is not used)
-    float largest = 0;
+    gather(n, lambda);
+    float largest = 0;  // squared
     for (size_t k = 0; k < n; ++k)
-      largest = std::max({largest, w[p.a[k]] * g[p.a[k]].squaredNorm() * w[p.a[k]], w[p.b[k]] * g[p.b[k]].squaredNorm() * w[p.b[k]]});
+      largest = std::max({largest, (w[p.a[k]] * g[p.a[k]]).squaredNorm(), (w[p.b[k]] * g[p.b[k]]).squaredNorm()});
     const float scale = largest > kMaxMove * kMaxMove ? kMaxMove / std::sqrt(largest) : 1.0f;
     for (size_t i = 0; i < particles; ++i) {
       const uint32_t k = node[i];

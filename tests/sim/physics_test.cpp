@@ -121,6 +121,23 @@ ClothModel cotton_ring(uint32_t n, float radius, float rest, float mass = 0.001f
   return compile(std::move(spec));
 }
 
+// Settings for the ring tests: no gravity, 4 position passes, 128 converge passes, the projection's
+// iterations as given.
+StepSettings ring_settings(const ClothModel& model, float threshold, int projection_iterations) {
+  StepSettings settings = default_step_settings(model);
+  settings.strain_threshold = threshold;
+  settings.gravity = Vec3f::Zero();
+  settings.position_passes = 4;
+  settings.converge_passes = 128;
+  settings.projection_iterations = projection_iterations;
+  return settings;
+}
+
+// A ring still being pulled wide: every particle moving outwards at `speed`.
+void pull_wide(ClothState& state, float speed) {
+  for (size_t i = 0; i < state.x.size(); ++i) state.v[i] = speed * Vec3f(state.x[i].x(), 0, state.x[i].z()).normalized();
+}
+
 // A ring of n particles whose structural springs are all 10 % too long (a waistband pulled wide):
 // the regular Gauss-Seidel passes shrink it only at ~(pi/n)^2 per pass, the converge passes over the
 // springs still near the limit bring every spring back to the threshold.
@@ -130,12 +147,8 @@ TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
   const ClothModel model = cotton_ring(n, 1.10f * rest / (2.0f * std::sin(3.14159265f / n)), rest);
   const auto ring_strain = [&](int converge_passes) {
     ClothState state = initial_state(model);
-    // The ring is still being pulled wide, at 0.5 m/s outwards.
-    for (uint32_t i = 0; i < n; ++i) state.v[i] = 0.5f * Vec3f(state.x[i].x(), 0, state.x[i].z()).normalized();
-    StepSettings settings = default_step_settings(model);
-    settings.strain_threshold = threshold;
-    settings.gravity = Vec3f::Zero();
-    settings.position_passes = 4;
+    pull_wide(state, 0.5f);  // the ring is still being pulled wide
+    StepSettings settings = ring_settings(model, threshold, 0);
     settings.converge_passes = converge_passes;
     StepScratch scratch(model);
     EXPECT_EQ(step(model, state, {}, settings, scratch), StepStatus::Ok);
@@ -148,18 +161,6 @@ TEST(ClothPhysics, ConvergePassesPullAStretchedRingBackToTheThreshold) {
   };
   EXPECT_GT(ring_strain(0), threshold + 0.02f);
   EXPECT_LT(ring_strain(256), threshold + 0.001f);
-}
-
-// Settings for the ring tests: no gravity, 4 position passes, 128 converge passes, the projection's
-// iterations as given.
-StepSettings ring_settings(const ClothModel& model, float threshold, int projection_iterations) {
-  StepSettings settings = default_step_settings(model);
-  settings.strain_threshold = threshold;
-  settings.gravity = Vec3f::Zero();
-  settings.position_passes = 4;
-  settings.converge_passes = 128;
-  settings.projection_iterations = projection_iterations;
-  return settings;
 }
 
 // A waistband of 120 springs, 0.5 % over the limit and still being pulled wide, in two halves sewn together
@@ -187,8 +188,7 @@ TEST(ClothPhysics, ProjectionPullsALongSewnRingBackWhereGaussSeidelCannot) {
   const std::array<std::array<uint32_t, 2>, 2> seams{{{half, half + 1}, {0u, n + 1}}};
   const auto run = [&](int projection_iterations, StepProfile& profile) {
     ClothState state = initial_state(model);
-    for (size_t i = 0; i < state.x.size(); ++i)
-      state.v[i] = 0.5f * Vec3f(state.x[i].x(), 0, state.x[i].z()).normalized();
+    pull_wide(state, 0.5f);
     StepSettings settings = ring_settings(model, threshold, projection_iterations);
     settings.joined_pairs = seams;
     StepScratch scratch(model);

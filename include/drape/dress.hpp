@@ -34,9 +34,19 @@ struct DressOptions {
   std::string fabric;  // empty: each garment's own
   // Sewing: seam springs pull the pairs together with gravity off and frictionless contact; a pair
   // closer than `seam_closed_m` is joined (held together from then on); sewing ends when every pair
-  // is joined, or after `max_sewing_seconds` of simulated time.
+  // is joined, or after `max_sewing_seconds` of simulated time, or when it is stuck: over a window
+  // of `sewing_stall_s` no pair was joined and the widest open pair, still wider than
+  // `sewing_stall_gap_m`, closed by less than `sewing_stall_m`. That is a pair pressed on the body by
+  // cloth at its limit, as at the crotch of jeans cut short for the body: gravity lets the cloth give
+  // way, and the seam springs go on pulling while draping. Pairs within `sewing_stall_gap_m` keep
+  // sewing, however slowly they close: several built-ins hover a millimetre or two above
+  // `seam_closed_m` for most of a second before they join, and draping early left them open.
+  // `sewing_stall_s` 0: sewing always runs to the cap.
   float seam_closed_m = 0.005f;
   double max_sewing_seconds = 1.5;
+  double sewing_stall_s = 0.2;
+  float sewing_stall_m = 0.001f;
+  float sewing_stall_gap_m = 0.015f;
   // Draping: gravity on until settled, for at most `max_drape_seconds` (5 s: a long hem hanging
   // from the hips creeps to rest at ~1/s under this damping, and several garments came to rest
   // between 2.5 and 3 s, so a 3 s cap decided them by rounding), with viscous damping
@@ -109,6 +119,7 @@ struct DressedGarment {
 
   // Measured on the way.
   uint64_t sewing_iterations = 0, drape_iterations = 0;
+  bool sewing_stalled = false;  // sewing ended with pairs open that no longer closed (DressOptions::sewing_stall_s)
   // Coarse-to-fine (DressOptions::coarse_edge): the coarse run this garment started from.
   struct CoarseRun {
     double edge = 0;            // m, 0: none (started from the placement)

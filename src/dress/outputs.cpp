@@ -89,6 +89,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"p99_strain", st.p99},
                         {"coarse_start", coarse},
                         {"sewing_iterations", g.sewing_iterations},
+                        {"sewing_stalled", g.sewing_stalled},
                         {"sewn_max_strain", g.sewn_max_strain},
                         {"relax_passes", g.relax_passes},
                         {"drape_iterations", g.drape_iterations},

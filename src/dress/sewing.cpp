@@ -80,6 +80,15 @@ bool join_closed_pairs(const ClothState& state, std::span<const std::array<uint3
   return all;
 }
 
+// The widest gap of the pairs not yet joined (0 when every pair is).
+float widest_open_pair(const ClothState& state, std::span<const std::array<uint32_t, 2>> pairs,
+                       const std::vector<uint8_t>& joined) {
+  float widest2 = 0;
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (!joined[i]) widest2 = std::max(widest2, (state.x[pairs[i][0]] - state.x[pairs[i][1]]).squaredNorm());
+  return std::sqrt(widest2);
+}
+
 }  // namespace
 
 void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, const DressOptions& o,
@@ -108,6 +117,11 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   held.reserve(g.seam_pairs.size());
   g.seams_closed = join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
   settings.joined_pairs = held;
+  // Stall windows: the pairs joined and the widest open pair at the start of the current one.
+  double stall_began = g.state.time;
+  size_t stall_joined = held.size();
+  float stall_gap = widest_open_pair(g.state, g.seam_pairs, joined);
+  g.sewing_stalled = false;
   while (!g.seams_closed && g.state.time < o.max_sewing_seconds && g.state.iterations < cap) {
     g.status = step(g.model, g.state, colliders, settings, scratch, &g.profile);
     if (g.status != StepStatus::Ok) break;
@@ -115,6 +129,16 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     g.seams_closed = join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
     settings.joined_pairs = held;
     report("sewing", o.max_sewing_seconds);
+    if (o.sewing_stall_s > 0 && !g.seams_closed && g.state.time - stall_began >= o.sewing_stall_s) {
+      const float gap = widest_open_pair(g.state, g.seam_pairs, joined);
+      if (held.size() == stall_joined && gap > o.sewing_stall_gap_m && stall_gap - gap < o.sewing_stall_m) {
+        g.sewing_stalled = true;
+        break;
+      }
+      stall_began = g.state.time;
+      stall_joined = held.size();
+      stall_gap = gap;
+    }
   }
   g.sewing_iterations = g.state.iterations;
   g.sewing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

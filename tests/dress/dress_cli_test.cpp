@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "dress/dress_support.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
 
@@ -123,6 +124,20 @@ TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
   EXPECT_NE(std::find(failed.begin(), failed.end(), "settled"), failed.end()) << failed.dump();
   EXPECT_NE(std::find(failed.begin(), failed.end(), "seams_closed"), failed.end()) << failed.dump();
   EXPECT_FALSE(report["quality"]["settled"].get<bool>());
+}
+
+// A size too small for the body: sewing stops with a seam open, the run fails its seams_closed
+// gate (exit 3, outputs written), and stderr names the seam and suggests a larger size.
+TEST(DressCli, StuckSeamIsNamedWithAHint) {
+  if (test::sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const auto dir = test::temp_dir("dress_stuck");
+  const auto r = test::run_drape("dress --garment shirt --size S --body male --out " + dir.string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("gate seams_closed failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("shirt S: sewing stopped after"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("a larger size may fit"), std::string::npos) << r.err;
+  const nlohmann::json report = read_json(dir / "report.json");
+  EXPECT_TRUE(report["garments"][0]["sewing_stalled"].get<bool>());
 }
 
 // With no --size each garment is made in the size its size chart gives the body (docs/garment-format.md):

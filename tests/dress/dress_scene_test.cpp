@@ -417,6 +417,35 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedFemaleBody,
                                            "bodies/makehuman/derived/mh_female_heavy.obj"),
                          body_stem);
 
+// Sewing ends when a pair no longer closes (DressOptions::sewing_stall_s): the women's S shirt on the
+// default male body, a size too small for him, keeps a seam open at his shoulder. Sewing stops well
+// before its 1.5 s cap, and sewing to the cap instead leaves the same seam open: stopping gave up no
+// pair that would still have closed. Its draping then settles, so the verdict is a seam, not motion.
+TEST(DressScene, SewingStopsWhenAPairNoLongerCloses) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const Body& body = cached_body(Sex::Male);
+  const GarmentSpec shirt = load_garment("shirt");
+  DressOptions to_the_cap;
+  to_the_cap.sewing_stall_s = 0;
+  const DressResult stopped = dress(body, {{shirt, "S"}});
+  const DressResult capped = dress(body, {{shirt, "S"}}, to_the_cap);
+  const DressedGarment &s = stopped.garments.at(0), &c = capped.garments.at(0);
+  EXPECT_TRUE(s.sewing_stalled);
+  EXPECT_FALSE(c.sewing_stalled);
+  EXPECT_LT(s.sewing_iterations * 2, c.sewing_iterations);
+  const auto widest_seam = [](const DressedGarment& g) {
+    std::vector<float> widest(g.seam_names.size(), 0.0f);
+    for (size_t i = 0; i < g.seam_pairs.size(); ++i)
+      widest.at(g.seam_of_pair.at(i)) = std::max(widest.at(g.seam_of_pair.at(i)),
+                                                 (g.state.x[g.seam_pairs[i][0]] - g.state.x[g.seam_pairs[i][1]]).norm());
+    return g.seam_names.at(static_cast<size_t>(std::max_element(widest.begin(), widest.end()) - widest.begin()));
+  };
+  EXPECT_GT(stopped.quality.max_seam_gap_m, 0.01f);
+  EXPECT_GT(capped.quality.max_seam_gap_m, 0.01f);
+  EXPECT_EQ(widest_seam(s), widest_seam(c));
+  EXPECT_TRUE(stopped.quality.settled);
+}
+
 // Layers: a skirt, then a shirt over it (outermost last); the shirt must not sink into the skirt.
 TEST(DressScene, TwoLayers) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";

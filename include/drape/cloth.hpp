@@ -270,6 +270,10 @@ class StepScratch {
   std::vector<float> block_speed;         // per block: max speed squared
   std::vector<uint32_t> block_count;      // per block: counters (contacts, corrections)
   std::vector<uint32_t> active_spring;    // strain-limited springs near the limit (converge passes)
+  // The converge passes' regathering of that set: per particle the strain-limited springs touching
+  // it (CSR), and one bit per strain-limited spring for the springs found near the limit.
+  std::vector<uint32_t> limit_incident_begin, limit_incident;
+  std::vector<uint64_t> near_limit_bits;
   std::vector<Vec3f> converge_start;      // per particle: position before the converge passes
   std::vector<Vec3f> step_start;          // per particle: position before this step's position update
   std::vector<uint32_t> changed_in_pass;  // per particle: 1 + the strain pass that last changed it

@@ -80,6 +80,21 @@ void StepScratch::resize(const ClothModel& model, size_t colliders) {
   block_speed.assign(blocks, 0.0f);
   block_count.assign(blocks, 0u);
   active_spring.assign(model.limit_a.size(), 0u);
+  limit_incident_begin.assign(model.particle_count() + 1, 0u);
+  for (size_t s = 0; s < model.limit_a.size(); ++s) {
+    ++limit_incident_begin[model.limit_a[s] + 1];
+    ++limit_incident_begin[model.limit_b[s] + 1];
+  }
+  for (size_t i = 0; i < model.particle_count(); ++i) limit_incident_begin[i + 1] += limit_incident_begin[i];
+  limit_incident.assign(2 * model.limit_a.size(), 0u);
+  {
+    std::vector<uint32_t> next(limit_incident_begin.begin(), limit_incident_begin.end() - 1);
+    for (size_t s = 0; s < model.limit_a.size(); ++s) {
+      limit_incident[next[model.limit_a[s]]++] = static_cast<uint32_t>(s);
+      limit_incident[next[model.limit_b[s]]++] = static_cast<uint32_t>(s);
+    }
+  }
+  near_limit_bits.assign((model.limit_a.size() + 63) / 64, 0u);
   const size_t edges = model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size();
   face_lift.edge.assign(edges, 0u);
   face_lift.block_measured.assign(sim::block_count(edges), 0u);
@@ -141,6 +156,7 @@ StepStatus step(const ClothModel& model, ClothState& state, std::span<Collider* 
       scratch.projection.gathered.size() != model.particle_count() ||
       scratch.projection.saved.size() != model.particle_count() ||
       scratch.projection.a.size() != model.limit_a.size() ||
+      scratch.limit_incident.size() != 2 * model.limit_a.size() ||
       scratch.step_start.size() != model.particle_count() ||
       scratch.face_lift.lift.size() != model.particle_count() ||
       scratch.face_lift.edge.size() != model.range(SpringKind::Structural).size() + model.range(SpringKind::Shear).size() ||

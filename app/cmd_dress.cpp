@@ -4,7 +4,6 @@
 // failed a quality gate (outputs written, report.json's `gates.failed` names it).
 #include <omp.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -122,14 +121,8 @@ void run_dress(const DressArgs& a) {
       if (!g.passed) std::fprintf(stderr, "drape: dress: gate %s failed: %s\n", g.name.c_str(), g.detail.c_str());
     // A seam that sewing could no longer close: name it, and say what that usually means.
     for (const DressedGarment& g : result.garments) {
-      if (!g.sewing_stalled || g.seam_names.empty()) continue;
-      std::vector<float> widest(g.seam_names.size(), 0.0f);
-      for (size_t i = 0; i < g.seam_pairs.size() && i < g.seam_of_pair.size(); ++i) {
-        const auto [pa, pb] = g.seam_pairs[i];
-        widest.at(g.seam_of_pair[i]) = std::max(widest.at(g.seam_of_pair[i]), (g.state.x[pa] - g.state.x[pb]).norm());
-      }
-      const size_t seam = static_cast<size_t>(std::max_element(widest.begin(), widest.end()) - widest.begin());
-      if (widest[seam] <= o.seam_closed_m) continue;  // closed while draping after all
+      const size_t seam = g.widest_seam();
+      if (!g.sewing_stalled || seam >= g.seam_names.size() || g.seam_gaps()[seam] <= o.seam_closed_m) continue;
       std::fprintf(stderr,
                    "drape: dress: %s %s: sewing stopped after %llu iterations with seam '%s' open: the cloth "
                    "around it was held at its stretch limit by the body; a larger size may fit\n",

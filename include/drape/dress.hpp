@@ -144,6 +144,8 @@ struct DressedGarment {
   StepProfile profile;
 
   Mesh mesh() const;  // positions, normals, TEXCOORD_0 = flat pattern coordinates (m)
+  std::vector<float> seam_gaps() const;  // per seam (seam_names): the widest gap of its pairs now, m
+  size_t widest_seam() const;            // the seam with the widest gap (seam_names.size() if none)
 };
 
 struct DressProgress {

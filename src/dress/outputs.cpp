@@ -50,13 +50,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
         const Vec3f mid = 0.5f * (g.state.x[a] + g.state.x[b]);
         worst = {mid.x(), mid.y(), mid.z()};
       }
-    // The widest gap of every seam.
-    std::vector<float> seam_gap(g.seam_names.size(), 0.0f);
-    for (size_t i = 0; i < g.seam_pairs.size() && i < g.seam_of_pair.size(); ++i) {
-      const auto [a, b] = g.seam_pairs[i];
-      float& widest_of_seam = seam_gap.at(g.seam_of_pair[i]);
-      widest_of_seam = std::max(widest_of_seam, (g.state.x[a] - g.state.x[b]).norm());
-    }
+    const std::vector<float> seam_gap = g.seam_gaps();
     nlohmann::ordered_json seams = nlohmann::ordered_json::array();
     for (size_t i = 0; i < seam_gap.size(); ++i) seams.push_back({{"seam", g.seam_names[i]}, {"max_gap_m", seam_gap[i]}});
     nlohmann::ordered_json coarse = nullptr;  // started from the placement

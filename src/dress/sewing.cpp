@@ -213,4 +213,18 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   g.drop_m = std::max(0.0f, before.y() - centre_of_mass(g.model, g.state.x).y());
 }
 
+std::vector<float> DressedGarment::seam_gaps() const {
+  std::vector<float> gaps(seam_names.size(), 0.0f);
+  for (size_t i = 0; i < seam_pairs.size() && i < seam_of_pair.size(); ++i) {
+    const auto [a, b] = seam_pairs[i];
+    gaps.at(seam_of_pair[i]) = std::max(gaps.at(seam_of_pair[i]), (state.x[a] - state.x[b]).norm());
+  }
+  return gaps;
+}
+
+size_t DressedGarment::widest_seam() const {
+  const std::vector<float> gaps = seam_gaps();
+  return static_cast<size_t>(std::max_element(gaps.begin(), gaps.end()) - gaps.begin());
+}
+
 }  // namespace drape

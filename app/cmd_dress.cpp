@@ -32,6 +32,7 @@ struct DressArgs {
   uint64_t max_iterations = 0;
   float mass_scaling = DressOptions{}.mass_scaling;
   float face_clearance = DressOptions{}.face_clearance;
+  double sewing_stall = DressOptions{}.sewing_stall_s;
   bool placement_only = false;
   std::string out = "out";
   LoadOptions load;
@@ -67,6 +68,9 @@ void run_dress(const DressArgs& a) {
   o.mass_scaling = a.mass_scaling;
   if (!(a.face_clearance <= 0.01)) throw InputError("--face-clearance", "must be at most 0.01 m (negative: off)");
   o.face_clearance = a.face_clearance;
+  if (!(a.sewing_stall >= 0 && a.sewing_stall <= o.max_sewing_seconds))
+    throw InputError("--sewing-stall", "must be in [0, 1.5] s (0: sew until every pair is joined or 1.5 s have passed)");
+  o.sewing_stall_s = a.sewing_stall;
   o.simulate = !a.placement_only;
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
@@ -166,6 +170,11 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--mass-scaling", args->mass_scaling,
                   "particles whose stability bound is below this fraction of the median particle's get more inertia "
                   "(weight unchanged), for a longer time step; the state of rest is the same (0: off)")
+      ->capture_default_str();
+  cmd->add_option("--sewing-stall", args->sewing_stall,
+                  "stop sewing when for this many seconds of simulated time no seam pair was joined and the widest "
+                  "open pair (over 15 mm) closed by less than 1 mm: the body holds it open, usually a size too small; "
+                  "draping then starts with the seam springs still pulling (0: sew to the 1.5 s cap)")
       ->capture_default_str();
   cmd->add_option("--face-clearance", args->face_clearance,
                   "while draping, keep the cloth's faces, not only its vertices, this many metres off the body where "

@@ -105,10 +105,14 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
   r = test::run_drape("dress --coarse-edge -0.02 --out " + (dir / "d").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--coarse-edge"), std::string::npos) << r.err;
+  r = test::run_drape("dress --sewing-stall -1 --out " + (dir / "e").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--sewing-stall"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "a"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b"));
   EXPECT_FALSE(std::filesystem::exists(dir / "c"));
   EXPECT_FALSE(std::filesystem::exists(dir / "d"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "e"));
 }
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
@@ -138,6 +142,11 @@ TEST(DressCli, StuckSeamIsNamedWithAHint) {
   EXPECT_NE(r.err.find("a larger size may fit"), std::string::npos) << r.err;
   const nlohmann::json report = read_json(dir / "report.json");
   EXPECT_TRUE(report["garments"][0]["sewing_stalled"].get<bool>());
+  // --sewing-stall 0 sews to the cap: no stall, no hint, the seam still open.
+  const auto capped = test::run_drape("dress --garment shirt --size S --body male --sewing-stall 0 --out " + (dir / "capped").string());
+  EXPECT_EQ(capped.exit_code, 3) << capped.err;
+  EXPECT_EQ(capped.err.find("sewing stopped"), std::string::npos) << capped.err;
+  EXPECT_FALSE(read_json(dir / "capped" / "report.json")["garments"][0]["sewing_stalled"].get<bool>());
 }
 
 // With no --size each garment is made in the size its size chart gives the body (docs/garment-format.md):

@@ -140,7 +140,13 @@ struct DressedGarment {
   StepStatus status = StepStatus::Ok;
   float initial_max_gap = 0;   // m, right after placement (prepare_garment)
   float time_step = 0;         // s
-  float drop_m = 0;            // centre of mass fall while draping
+  // How far the centre of mass fell from where placement put the garment to the end: a garment that
+  // slid down the body. Measured from the placement, not from the end of sewing: sewing has no
+  // gravity, so a flared hem sewn into a cone stands out like a lampshade and only hangs once
+  // draping starts (the GarmentCode flare skirt's centre rises 0.14 m while sewing and falls 0.19 m
+  // while draping, its waistband 3 cm); that fall is the skirt hanging, not sliding.
+  float drop_m = 0;
+  float placed_centre_y = 0, sewn_centre_y = 0, final_centre_y = 0;  // m, the centre of mass's height
   StepProfile profile;
 
   Mesh mesh() const;  // positions, normals, TEXCOORD_0 = flat pattern coordinates (m)

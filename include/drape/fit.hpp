@@ -55,7 +55,7 @@ struct FitQuality {
   // Not in `quality` but gated:
   bool finite = true;             // no NaN / explosion
   float lowest_y = 0;             // m, lowest garment vertex (the floor is y = 0)
-  float drop_m = 0;               // how far the garments' centre of mass fell while draping
+  float drop_m = 0;               // how far a garment's centre of mass fell from where it was placed
   size_t vertices = 0;
   // Reported beside `quality`, not gated: measure_skin_through over every garment.
   SkinThroughStats skin_through;

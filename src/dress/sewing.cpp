@@ -106,6 +106,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
     if (progress && g.state.iterations % 50 == 0)
       progress({index, count, phase, g.state.iterations, g.state.time, limit});
   };
+  g.placed_centre_y = g.final_centre_y = centre_of_mass(g.model, g.state.x).y();
   if (!o.simulate) return;
 
   // Sewing: no gravity until every pair is closed.
@@ -184,7 +185,7 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   // Not while sewing: there the seams must be able to pull the cloth past the limit for a moment.
   settings.converge_passes = kConvergePasses;
   settings.projection_iterations = o.projection_iterations;
-  const Vec3f before = centre_of_mass(g.model, g.state.x);
+  g.sewn_centre_y = centre_of_mass(g.model, g.state.x).y();
   const double drape_start = g.state.time;
   // Settle windows: positions at the start of the current window (allocated once).
   std::vector<Vec3f> window_start = g.state.x;
@@ -210,7 +211,8 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   }
   g.drape_iterations = g.state.iterations - g.sewing_iterations;
   g.drape_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  g.drop_m = std::max(0.0f, before.y() - centre_of_mass(g.model, g.state.x).y());
+  g.final_centre_y = centre_of_mass(g.model, g.state.x).y();
+  g.drop_m = std::max(0.0f, g.placed_centre_y - g.final_centre_y);
 }
 
 std::vector<float> DressedGarment::seam_gaps() const {

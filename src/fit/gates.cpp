@@ -25,7 +25,7 @@ std::vector<GateResult> evaluate_gates(const FitQuality& q, float strain_thresho
   gate("above_floor", q.finite && q.lowest_y >= g.floor_y, q.lowest_y, g.floor_y,
        fmt::format("lowest garment vertex at y = {:.3f} m", q.lowest_y));
   gate("stayed_on", q.finite && q.drop_m <= g.max_drop_m, q.drop_m, g.max_drop_m,
-       fmt::format("garment centre fell {:.3f} m while draping (limit {:.2f} m)", q.drop_m, g.max_drop_m));
+       fmt::format("garment centre fell {:.3f} m from where it was placed (limit {:.2f} m)", q.drop_m, g.max_drop_m));
   return out;
 }
 

@@ -33,6 +33,7 @@ struct DressArgs {
   float mass_scaling = DressOptions{}.mass_scaling;
   float face_clearance = DressOptions{}.face_clearance;
   double sewing_stall = DressOptions{}.sewing_stall_s;
+  float pull_closed = DressOptions{}.pull_closed_m;
   bool placement_only = false;
   std::string out = "out";
   LoadOptions load;
@@ -71,6 +72,9 @@ void run_dress(const DressArgs& a) {
   if (!(a.sewing_stall >= 0 && a.sewing_stall <= o.max_sewing_seconds))
     throw InputError("--sewing-stall", "must be in [0, 1.5] s (0: sew until every pair is joined or 1.5 s have passed)");
   o.sewing_stall_s = a.sewing_stall;
+  if (!(a.pull_closed >= 0 && a.pull_closed <= o.sewing_stall_gap_m))
+    throw InputError("--pull-closed", "must be in [0, 0.015] m (0: leave every open pair to the seam springs)");
+  o.pull_closed_m = a.pull_closed;
   o.simulate = !a.placement_only;
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
@@ -175,6 +179,11 @@ void add_dress_command(CLI::App& app) {
                   "stop sewing when for this many seconds of simulated time no seam pair was joined and the widest "
                   "open pair (over 15 mm) closed by less than 1 mm: the body holds it open, usually a size too small; "
                   "draping then starts with the seam springs still pulling (0: sew to the 1.5 s cap)")
+      ->capture_default_str();
+  cmd->add_option("--pull-closed", args->pull_closed,
+                  "when sewing ends, pull the seam pairs still open by at most this many metres closed and join them, "
+                  "as a sewer closes the last stitches (the paper's seaming after a number of iterations); wider "
+                  "pairs are left to the seam springs and reported (0: none)")
       ->capture_default_str();
   cmd->add_option("--face-clearance", args->face_clearance,
                   "while draping, keep the cloth's faces, not only its vertices, this many metres off the body where "

@@ -84,6 +84,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"coarse_start", coarse},
                         {"sewing_iterations", g.sewing_iterations},
                         {"sewing_stalled", g.sewing_stalled},
+                        {"pulled_closed_pairs", g.pulled_closed},
                         {"sewn_max_strain", g.sewn_max_strain},
                         {"relax_passes", g.relax_passes},
                         {"drape_iterations", g.drape_iterations},

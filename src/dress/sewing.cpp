@@ -141,6 +141,24 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
       stall_gap = gap;
     }
   }
+  // The last stitches (DressOptions::pull_closed_m): pairs still open by a few millimetres are
+  // pulled closed and joined, momentum kept; the relaxation below and the draping's strain passes
+  // take up the jump.
+  g.pulled_closed = 0;
+  if (o.pull_closed_m > 0 && !g.seams_closed && g.status == StepStatus::Ok) {
+    for (size_t i = 0; i < g.seam_pairs.size(); ++i) {
+      const auto [a, b] = g.seam_pairs[i];
+      if (joined[i] || (g.state.x[a] - g.state.x[b]).norm() > o.pull_closed_m) continue;
+      const float wa = g.model.mass[a], wb = g.model.mass[b];
+      const Vec3f x = (wa * g.state.x[a] + wb * g.state.x[b]) / (wa + wb);
+      const Vec3f v = (wa * g.state.v[a] + wb * g.state.v[b]) / (wa + wb);
+      g.state.x[a] = g.state.x[b] = x;
+      g.state.v[a] = g.state.v[b] = v;
+      ++g.pulled_closed;
+    }
+    g.seams_closed = join_closed_pairs(g.state, g.seam_pairs, joined, held, o.seam_closed_m);
+    settings.joined_pairs = held;
+  }
   g.sewing_iterations = g.state.iterations;
   g.sewing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

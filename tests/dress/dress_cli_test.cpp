@@ -108,11 +108,15 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
   r = test::run_drape("dress --sewing-stall -1 --out " + (dir / "e").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--sewing-stall"), std::string::npos) << r.err;
+  r = test::run_drape("dress --pull-closed 0.02 --out " + (dir / "f").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--pull-closed"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "a"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b"));
   EXPECT_FALSE(std::filesystem::exists(dir / "c"));
   EXPECT_FALSE(std::filesystem::exists(dir / "d"));
   EXPECT_FALSE(std::filesystem::exists(dir / "e"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "f"));
 }
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {

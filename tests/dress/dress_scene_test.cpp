@@ -240,13 +240,19 @@ INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
                                            // of them is his cut by the chart, but they fit him).
                                            Fit{"dress", "S", Sex::Female}, Fit{"dress", "M", Sex::Female},
                                            Fit{"skirt", "S", Sex::Female}, Fit{"skirt", "L", Sex::Male},
-                                           Fit{"jeans", "L", Sex::Male}),
+                                           Fit{"jeans", "L", Sex::Male},
+                                           // Since the last stitches are pulled closed when sewing ends
+                                           // (DressOptions::pull_closed_m; session 13): before, a pair a
+                                           // few millimetres open at the end of sewing opened to 15 mm
+                                           // under gravity (LastStitchesArePulledClosedWhenSewingEnds).
+                                           Fit{"trousers", "L", Sex::Male}, Fit{"dress", "L", Sex::Male}),
                          fit_name);
 
 // NOT YET REACHED (measured failures, see docs/dressing.md "Status"). Sizes not meant for the body
 // (by the garment's size chart, not the size `drape dress` makes for it) are listed with the reason:
-// - shirt and dress S/M/L on the male body (XL is his cut): a shoulder/armhole corner 10-20 mm open,
-//   the dress's shoulder seams 26-30 mm open at his wider neck;
+// - shirt S/M/L and dress S/M on the male body (XL is his cut): a shoulder/armhole corner 10-20 mm
+//   open, the dress's shoulder seams 26-30 mm open at his wider neck (the dress L passes since
+//   session 13, its last stitches pulled closed);
 // - trousers and jeans S on the female body (S is drafted for a 0.70 m waist, hers is 0.74 m): the
 //   trousers' S (its waist 4 cm lower since it is graded for the slimmer body) leaves an outseam's
 //   top corner 26 mm open (before: 5.0 %, not settled); the jeans' 27 mm open at the hip;
@@ -254,7 +260,8 @@ INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
 //   and jeans S/M/L on the male body (XL is his cut): the band holds an outseam's top corner
 //   15-36 mm open, or the trousers slide off (stayed_on, above_floor), or keep sliding (settled).
 //   At a6f396c: trousers S/M slide off him (0.52 m), L leaves an outseam 17.6 mm open; jeans S/M
-//   leave one 38/36 mm open (skirt S/M: 40/27 mm open). Skirt L and jeans L pass since 0e1e0b8.
+//   leave one 38/36 mm open (skirt S/M: 40/27 mm open). Skirt L and jeans L pass since 0e1e0b8,
+//   trousers L since session 13 (the last stitches pulled closed).
 // An elastic band on the trousers' four waist edges (docs/garment-format.md, Elastic bands; 22:25
 // UTC, a6f396c) held S on the slim MakeHuman man, but pulled the outseams' top corners 30-63 mm
 // open on the female body in M and L (which pass without it) and did not keep M/L on the default
@@ -269,12 +276,11 @@ std::vector<Fit> not_yet() {
   std::vector<Fit> fits;
   for (const char* size : {"S", "M", "L"}) {
     fits.push_back({"shirt", size, Sex::Male});
-    fits.push_back({"dress", size, Sex::Male});
+    if (std::string(size) != "L") fits.push_back({"dress", size, Sex::Male});  // L: in BuiltinFit
     for (const char* garment : {"skirt", "trousers", "jeans"})
       for (Sex sex : {Sex::Female, Sex::Male}) {
         const std::string g = garment, sz = size;
-        const bool passes = (g == "skirt" && sz == "S" && sex == Sex::Female) ||
-                            (g != "trousers" && sz == "L" && sex == Sex::Male);  // in BuiltinFit
+        const bool passes = (g == "skirt" && sz == "S" && sex == Sex::Female) || (sz == "L" && sex == Sex::Male);  // in BuiltinFit
         if ((sex == Sex::Male || sz == "S") && !passes) fits.push_back({garment, size, sex});
       }
   }
@@ -343,14 +349,15 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSize,
                                            SharedFit{"trousers", kFemaleAverage, "S"}, SharedFit{"jeans", kMaleThin, "XS"},
                                            // Since 0e1e0b8 (23:28 UTC, 4072b38): before, neither settled
                                            // within 3 s (the skirt's waist trembled at up to 7.9 m/s).
-                                           SharedFit{"shirt", kMeanAll, "XL"}, SharedFit{"skirt", kMeanAll, "L"}),
+                                           SharedFit{"shirt", kMeanAll, "XL"}, SharedFit{"skirt", kMeanAll, "L"},
+                                           // Since the last stitches are pulled closed (session 13): before,
+                                           // both outseams stayed 8 mm open at her hips.
+                                           SharedFit{"jeans", kFemaleHeavy, "M"}),
                          shared_fit_name);
 
 // NOT YET REACHED in the size chosen for the shared body (measured, docs/dressing.md "Status";
 // re-measured at a6f396c, 22:38 UTC): jeans XL on mean_all (an outseam's top corner
-// 16 mm open); jeans M on the heavy female MakeHuman body (re-measured at 13f65e4: both outseams
-// 8 mm open at the hip, denim at its 2 % limit: M is drafted for 0.99 m hips, hers are 1.03 m, so M
-// is too small for her; L passes, JeansLOnHeavyFemaleBody); trousers M on the average
+// 16 mm open; session 13: 11 mm); trousers M on the average
 // male MakeHuman body (waist 0.75 m, hips 0.94 m: M slides 0.20 m; eight men's sizes for him
 // graded like XS, waist 0.84-0.91 m, 4-11 cm lower, hips 1.02-1.05 m, either slid 0.16-0.20 m or
 // left an outseam's top corner 20-42 mm open).
@@ -361,8 +368,7 @@ TEST_P(SharedBodyOwnSizeNotYet, DISABLED_PassesTheGates) {
   expect_dressed(load_body(path), GetParam().garment, "");
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSizeNotYet,
-                         ::testing::Values(SharedFit{"jeans", kMeanAll, "XL"}, SharedFit{"jeans", kFemaleHeavy, "M"},
-                                           SharedFit{"trousers", kMaleAverage, "M"}),
+                         ::testing::Values(SharedFit{"jeans", kMeanAll, "XL"}, SharedFit{"trousers", kMaleAverage, "M"}),
                          shared_fit_name);
 
 // The heavy female body (upper arm 0.30 m) wears the shirt's L: in M a sleeve's armhole corner
@@ -374,7 +380,8 @@ TEST(DressScene, ShirtLOnHeavyFemaleBody) {
 }
 
 // The jeans' L (drafted for 1.03 m hips) on the heavy female body (hips 1.03 m): every gate. Her
-// size by the chart is M (nearest over waist and hips), which is too small for her hips in denim.
+// size by the chart is M (nearest over waist and hips), which passes too since session 13 (before,
+// both outseams stayed 8 mm open at her hips; SharedBodyOwnSize).
 TEST(DressScene, JeansLOnHeavyFemaleBody) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const auto path = DRAPE_REQUIRE_SHARED("bodies/makehuman/derived/mh_female_heavy.obj");
@@ -418,9 +425,11 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedFemaleBody,
                          body_stem);
 
 // Sewing ends when a pair no longer closes (DressOptions::sewing_stall_s): the women's S shirt on the
-// default male body, a size too small for him, keeps a seam open at his shoulder. Sewing stops well
-// before its 1.5 s cap, and sewing to the cap instead leaves the same seam open: stopping gave up no
-// pair that would still have closed. Its draping then settles, so the verdict is a seam, not motion.
+// default male body, a size too small for him, keeps its seams open at his armpits, where the side
+// seam, the sleeve's underarm seam and the armhole meet (14.5 mm). Sewing stops well before its
+// 1.5 s cap, and sewing to the cap instead leaves every seam as open (within a millimetre): stopping
+// gave up no pair that would still have closed. Its draping then settles, so the verdict is a seam,
+// not motion.
 TEST(DressScene, SewingStopsWhenAPairNoLongerCloses) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const Body& body = cached_body(Sex::Male);
@@ -436,9 +445,35 @@ TEST(DressScene, SewingStopsWhenAPairNoLongerCloses) {
   EXPECT_GT(stopped.quality.max_seam_gap_m, 0.01f);
   EXPECT_GT(capped.quality.max_seam_gap_m, 0.01f);
   ASSERT_LT(s.widest_seam(), s.seam_names.size());
-  EXPECT_EQ(s.seam_names[s.widest_seam()], c.seam_names[c.widest_seam()]);
+  const std::vector<float> s_gaps = s.seam_gaps(), c_gaps = c.seam_gaps();
+  ASSERT_EQ(s_gaps.size(), c_gaps.size());
+  for (size_t k = 0; k < s_gaps.size(); ++k) EXPECT_NEAR(s_gaps[k], c_gaps[k], 0.001f) << s.seam_names[k];
   EXPECT_NEAR(s.seam_gaps()[s.widest_seam()], stopped.quality.max_seam_gap_m, 1e-6f);
   EXPECT_TRUE(stopped.quality.settled);
+}
+
+// The last stitches (DressOptions::pull_closed_m): the trousers' L on the default male body end their
+// sewing (1.5 s) with a few pairs at the outseams' top corners still open by under a centimetre, light
+// corner pairs whose seam springs cannot beat the cloth's tension there. Pulled closed and joined,
+// they stay closed and every gate passes within wool's strain limit; left to the seam springs
+// (pull_closed_m 0) gravity opens them to 15 mm while draping.
+TEST(DressScene, LastStitchesArePulledClosedWhenSewingEnds) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const Body& body = cached_body(Sex::Male);
+  const GarmentSpec trousers = load_garment("trousers");
+  DressOptions left_open;
+  left_open.pull_closed_m = 0;
+  const DressResult pulled = dress(body, {{trousers, "L"}});
+  const DressResult open = dress(body, {{trousers, "L"}}, left_open);
+  const DressedGarment &p = pulled.garments.at(0), &o = open.garments.at(0);
+  EXPECT_FALSE(p.sewing_stalled);
+  EXPECT_GT(p.pulled_closed, 0u);
+  EXPECT_EQ(o.pulled_closed, 0u);
+  EXPECT_EQ(p.sewing_iterations, o.sewing_iterations);  // the same sewing, up to its end
+  EXPECT_LE(pulled.quality.max_seam_gap_m, 0.002f);
+  EXPECT_LE(pulled.quality.max_strain, p.model.fabric.strain_threshold + 0.01f);
+  EXPECT_TRUE(pulled.passed()) << test::failed_gates(pulled);
+  EXPECT_GT(open.quality.max_seam_gap_m, DressOptions{}.pull_closed_m);
 }
 
 // Layers: a skirt, then a shirt over it (outermost last); the shirt must not sink into the skirt.

@@ -424,6 +424,17 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedFemaleBody,
                                            "bodies/makehuman/derived/mh_female_heavy.obj"),
                          body_stem);
 
+// One built-in garment on a default body dressed twice: with the default options, then with one
+// option set to `value`.
+template <class T>
+std::pair<DressResult, DressResult> dress_both_ways(Sex sex, const std::string& garment, const std::string& size,
+                                                    T DressOptions::*option, T value) {
+  const GarmentSpec spec = load_garment(garment);
+  DressOptions other;
+  other.*option = value;
+  return {dress(cached_body(sex), {{spec, size}}), dress(cached_body(sex), {{spec, size}}, other)};
+}
+
 // Sewing ends when a pair no longer closes (DressOptions::sewing_stall_s): the women's S shirt on the
 // default male body, a size too small for him, keeps its seams open at his armpits, where the side
 // seam, the sleeve's underarm seam and the armhole meet (14.5 mm). Sewing stops well before its
@@ -432,12 +443,7 @@ INSTANTIATE_TEST_SUITE_P(Bodies, SharedFemaleBody,
 // not motion.
 TEST(DressScene, SewingStopsWhenAPairNoLongerCloses) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
-  const Body& body = cached_body(Sex::Male);
-  const GarmentSpec shirt = load_garment("shirt");
-  DressOptions to_the_cap;
-  to_the_cap.sewing_stall_s = 0;
-  const DressResult stopped = dress(body, {{shirt, "S"}});
-  const DressResult capped = dress(body, {{shirt, "S"}}, to_the_cap);
+  const auto [stopped, capped] = dress_both_ways(Sex::Male, "shirt", "S", &DressOptions::sewing_stall_s, 0.0);  // to the cap
   const DressedGarment &s = stopped.garments.at(0), &c = capped.garments.at(0);
   EXPECT_TRUE(s.sewing_stalled);
   EXPECT_FALSE(c.sewing_stalled);
@@ -459,12 +465,7 @@ TEST(DressScene, SewingStopsWhenAPairNoLongerCloses) {
 // (pull_closed_m 0) gravity opens them to 15 mm while draping.
 TEST(DressScene, LastStitchesArePulledClosedWhenSewingEnds) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
-  const Body& body = cached_body(Sex::Male);
-  const GarmentSpec trousers = load_garment("trousers");
-  DressOptions left_open;
-  left_open.pull_closed_m = 0;
-  const DressResult pulled = dress(body, {{trousers, "L"}});
-  const DressResult open = dress(body, {{trousers, "L"}}, left_open);
+  const auto [pulled, open] = dress_both_ways(Sex::Male, "trousers", "L", &DressOptions::pull_closed_m, 0.0f);
   const DressedGarment &p = pulled.garments.at(0), &o = open.garments.at(0);
   EXPECT_FALSE(p.sewing_stalled);
   EXPECT_GT(p.pulled_closed, 0u);

@@ -8,6 +8,7 @@
 // The pipeline is dress(); every stage is a public function so tests and benchmarks can run
 // them one at a time. See docs/dressing.md for the placement, the sewing and settling criteria
 // and the quality gates.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -149,14 +150,15 @@ struct DressedGarment {
   StepStatus status = StepStatus::Ok;
   float initial_max_gap = 0;   // m, right after placement (prepare_garment)
   float time_step = 0;         // s
-  // How far the centre of mass fell from where placement put the garment to the end: a garment that
-  // slid down the body. Measured from the placement, not from the end of sewing: sewing has no
-  // gravity, so a flared hem sewn into a cone stands out like a lampshade and only hangs once
-  // draping starts (the GarmentCode flare skirt's centre rises 0.14 m while sewing and falls 0.19 m
-  // while draping, its waistband 3 cm); that fall is the skirt hanging, not sliding.
-  float drop_m = 0;
   float placed_centre_y = 0, sewn_centre_y = 0, final_centre_y = 0;  // m, the centre of mass's height
   StepProfile profile;
+
+  // How far the centre of mass fell from where placement put the garment to the end (0 if it rose):
+  // a garment that slid down the body. Measured from the placement, not from the end of sewing:
+  // sewing has no gravity, so a flared hem sewn into a cone stands out like a lampshade and only
+  // hangs once draping starts (the GarmentCode flare skirt's centre rises 0.14 m while sewing and
+  // falls 0.19 m while draping, its waistband 3 cm); that fall is the skirt hanging, not sliding.
+  float drop_m() const { return std::max(0.0f, placed_centre_y - final_centre_y); }
 
   Mesh mesh() const;  // positions, normals, TEXCOORD_0 = flat pattern coordinates (m)
   std::vector<float> seam_gaps() const;  // per seam (seam_names): the widest gap of its pairs now, m

@@ -58,7 +58,7 @@ FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garm
       q.skin_through.max_depth_m = std::max(q.skin_through.max_depth_m, skin.max_depth_m);
     }
     q.lowest_y = std::min(q.lowest_y, m.lowest_y);
-    q.drop_m = std::max(q.drop_m, g.drop_m);
+    q.drop_m = std::max(q.drop_m, g.drop_m());
   }
   if (!all_strain.empty()) {
     const size_t k = std::min(all_strain.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(all_strain.size())));

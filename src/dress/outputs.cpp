@@ -99,7 +99,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         // steps whose last pass still corrected springs (the passes' cost: docs/cloth.md).
                         {"strain_passes_per_iteration", g.profile.steps ? double(g.profile.strain_passes) / double(g.profile.steps) : 0.0},
                         {"iterations_at_pass_limit", g.profile.steps_at_pass_limit},
-                        {"centre_drop_m", g.drop_m},
+                        {"centre_drop_m", g.drop_m()},
                         // The centre of mass's height where placement put the garment, when sewing
                         // ended and at the end: centre_drop_m is placed - final (0 if it rose).
                         {"centre_height_m", {{"placed", g.placed_centre_y}, {"sewn", g.sewn_centre_y}, {"final", g.final_centre_y}}},

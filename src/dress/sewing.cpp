@@ -230,7 +230,6 @@ void sew_and_drape(DressedGarment& g, std::span<Collider* const> colliders, cons
   g.drape_iterations = g.state.iterations - g.sewing_iterations;
   g.drape_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   g.final_centre_y = centre_of_mass(g.model, g.state.x).y();
-  g.drop_m = std::max(0.0f, g.placed_centre_y - g.final_centre_y);
 }
 
 std::vector<float> DressedGarment::seam_gaps() const {

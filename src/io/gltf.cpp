@@ -808,6 +808,11 @@ void GltfWriter::add_scene(const Scene& scene) {
     for (size_t c = 0; c < scene.nodes.size(); ++c)
       if (scene.nodes[c].parent == static_cast<int>(i)) gn.children.push_back(static_cast<int>(c));
     if (node.parent < 0) gs.nodes.push_back(static_cast<int>(i));
+    // tinygltf writes a node with no property at all as null, which no reader accepts: an unnamed,
+    // empty node (a bare joint or group) says its identity translation instead.
+    if (gn.name.empty() && gn.mesh < 0 && gn.children.empty() && gn.translation.empty() && gn.rotation.empty() &&
+        gn.scale.empty())
+      gn.translation = {0.0, 0.0, 0.0};
     model_.nodes.push_back(gn);
   }
   // A mesh on no node would be invisible (and merge_scene places it at the origin): give it a root node.

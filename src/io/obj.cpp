@@ -20,7 +20,7 @@ namespace drape::io {
 namespace {
 
 bool is_blank(char c) {
-  return c == ' ' || c == '\t' || c == '\r';
+  return c == ' ' || c == '\t';
 }
 
 // Splits a line into whitespace-separated tokens, stopping at a comment.
@@ -115,12 +115,14 @@ ObjScan scan_obj(std::string_view text, const std::string& source) {
     }
   };
 
+  // Lines end at \n, \r or \r\n, as tinyobjloader splits them: both must see the same lines, or the
+  // scan would count vertices the loader never reads.
   size_t pos = 0;
   while (pos < text.size()) {
-    size_t end = text.find('\n', pos);
+    size_t end = text.find_first_of("\r\n", pos);
     if (end == std::string_view::npos) end = text.size();
     const std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
+    pos = end + (text.substr(end, 2) == "\r\n" ? 2 : 1);
     ++line_number;
     const auto tok = tokens_of(line);
     if (tok.empty()) continue;
@@ -188,7 +190,15 @@ Scene parse_obj(std::string_view text, const std::string& source, MeshCheck& che
   std::vector<int> source_vertex;  // file vertex of each appended copy
   std::vector<std::pair<int, int>> copy_attributes;
   bool any_uv = false, every_normal = true;
+  // The scan checked every index; the loader's are checked again before use, so a file the two read
+  // differently is refused instead of indexing past the arrays.
+  const size_t file_texcoords = attrib.texcoords.size() / 2, file_normals = attrib.normals.size() / 3;
   const auto vertex_of = [&](const tinyobj::index_t& idx) -> uint32_t {
+    if (idx.vertex_index < 0 || static_cast<size_t>(idx.vertex_index) >= file_vertices ||
+        idx.texcoord_index < -1 || (idx.texcoord_index >= 0 && static_cast<size_t>(idx.texcoord_index) >= file_texcoords) ||
+        idx.normal_index < -1 || (idx.normal_index >= 0 && static_cast<size_t>(idx.normal_index) >= file_normals))
+      throw InputError(source, fmt::format("face index out of range (the file has {} vertices, {} texture "
+                                           "coordinates, {} normals)", file_vertices, file_texcoords, file_normals));
     const auto v = static_cast<size_t>(idx.vertex_index);
     any_uv |= idx.texcoord_index >= 0;
     every_normal &= idx.normal_index >= 0;

@@ -187,6 +187,19 @@ TEST(Obj, MalformedInputIsRefusedWithLine) {
   EXPECT_NE(message(std::string("v 0 0 0\0\x01", 9)).find("binary"), std::string::npos);
 }
 
+// A lone carriage return ends a line, as in the loader: "v\r1 2 3" is a vertex without numbers, refused
+// by line, never counted as a fourth vertex that the loader does not read.
+TEST(Obj, CarriageReturnsEndLinesLikeTheLoader) {
+  const Scene ok = parse_text("v 0 0 0\rv 1 0 0\r\nv 0 1 0\rf 1 2 3\r", MeshFormat::Obj);
+  EXPECT_EQ(merge_scene(ok).triangles.size(), 1u);
+  try {
+    parse_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv\r1 2 3\nf 1 2 4\n", MeshFormat::Obj);
+    ADD_FAILURE() << "a face on a vertex the loader does not read was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 4: vertex has 0 numbers"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Ply, AsciiAndBinaryEncodingsReadTheSame) {
   Mesh m = merge_scene(parse_text(kCubeObj, MeshFormat::Obj));
   m.normals = vertex_normals(m.positions, m.triangles);
@@ -347,6 +360,19 @@ TEST(Gltf, AnimationsMorphTargetsAndHierarchyRoundTrip) {
   }
   EXPECT_TRUE(r.skins[0].inverse_bind_matrices[0].isApprox(s.skins[0].inverse_bind_matrices[0]));
   fs::remove_all(dir);
+}
+
+// An unnamed node with nothing on it (a bare joint or group) is written as a node, not as null.
+TEST(Gltf, UnnamedEmptyNodeIsWrittenAsANode) {
+  Scene s;
+  add_mesh_node(s, merge_scene(parse_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", MeshFormat::Obj)), "");
+  s.nodes.emplace_back();
+  const Scene again = parse_scene(encode_glb(s), MeshFormat::Glb, "again.glb");
+  ASSERT_EQ(again.nodes.size(), 2u);
+  EXPECT_TRUE(again.nodes[1].name.empty());
+  EXPECT_EQ(again.nodes[1].mesh, -1);
+  EXPECT_EQ(again.nodes[1].translation, Vec3f::Zero());
+  EXPECT_EQ(encode_gltf(s).find("null"), std::string::npos);
 }
 
 TEST(Units, CentimetreZUpCopyLoadsLikeTheMetreYUpOriginal) {

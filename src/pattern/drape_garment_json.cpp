@@ -213,6 +213,11 @@ GarmentSpec parse_drape_garment(const Json& root, const std::string& source, con
   // Panels from a DXF file: the companion names pieces, seams and hints.
   if (const Json* dxf = optional_field(root, "dxf")) {
     const std::string rel = as_string(*dxf, top.at("dxf"));
+    // The pieces lie beside the garment file: an uploaded file must not name any other file.
+    const std::filesystem::path rel_path(rel);
+    if (rel.empty() || rel_path.is_absolute() || rel_path.has_root_name() ||
+        std::any_of(rel_path.begin(), rel_path.end(), [](const std::filesystem::path& part) { return part == ".."; }))
+      top.at("dxf").fail("expected a file name relative to the garment file's folder, without '..'");
     DxfOptions options;
     if (const Json* u = optional_field(root, "units")) {
       options.units = as_string(*u, top.at("units"));

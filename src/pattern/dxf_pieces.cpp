@@ -73,6 +73,15 @@ double number(const GroupPair& p, const std::string& source) {
   return v;
 }
 
+// Codes 60-99 are 16-bit integers; anything else there is an error, never an overflowing cast.
+int integer(const GroupPair& p, const std::string& source) {
+  const double v = number(p, source);
+  if (v != std::floor(v) || std::abs(v) > 32767)
+    throw InputError(source, fmt::format("line {}: expected a 16-bit integer for group code {}, found \"{}\"", p.line + 1,
+                                         p.code, p.value.substr(0, 40)));
+  return static_cast<int>(v);
+}
+
 // One entity: its type and its group codes until the next code 0.
 struct Entity {
   std::string type;
@@ -115,7 +124,7 @@ void collect(const std::vector<GroupPair>& pairs, std::vector<Block>& blocks, st
     if (p.code == 0 && p.value == "ENDSEC") { section.clear(); block = nullptr; continue; }
     if (section == "HEADER") {
       if (p.code == 9) header_var = p.value;
-      else if (p.code == 70) header_ints[header_var] = static_cast<int>(number(p, source));
+      else if (p.code == 70) header_ints[header_var] = integer(p, source);
       continue;
     }
     if (p.code != 0) continue;
@@ -135,7 +144,8 @@ void collect(const std::vector<GroupPair>& pairs, std::vector<Block>& blocks, st
     }
     i = j - 1;
     if (e.type == "BLOCK") {
-      if (const GroupPair* n = e.get(2)) block->name = n->value;
+      // A BLOCK outside the BLOCKS section starts no block.
+      if (const GroupPair* n = e.get(2); n && block) block->name = n->value;
       continue;
     }
     if (e.type == "TEXT" || e.type == "MTEXT")

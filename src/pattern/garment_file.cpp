@@ -67,6 +67,11 @@ Json parse_json_text(std::string_view text, const std::string& source, bool allo
     else if (const size_t br = reason.find("] "); br != std::string::npos)
       reason = reason.substr(br + 2);
     throw InputError(source, one_line(fmt::format("invalid JSON at line {}, column {}: {}", line, column, reason)));
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number too large for a double ("1e999"): nlohmann names the number, not where it is.
+    std::string reason = e.what();
+    if (const size_t br = reason.find("] "); br != std::string::npos) reason = reason.substr(br + 2);
+    throw InputError(source, one_line(fmt::format("invalid JSON: {}", reason.substr(0, 120))));
   }
 }
 

@@ -25,6 +25,7 @@ struct DressArgs {
   std::vector<std::string> sizes;
   std::string fabric;
   std::string collision = "image";
+  std::string solver = std::string(to_string(DressOptions{}.solver));
   std::string mesher = "grid";
   double edge = kPaperEdgeLength;
   double coarse_edge = DressOptions{}.coarse_edge;
@@ -56,6 +57,7 @@ void run_dress(const DressArgs& a) {
   const auto method = parse_collision_method(a.collision);
   if (!method) throw InputError("--collision", "'" + a.collision + "' is not image, bvh or sdf");
   o.collision = *method;
+  o.solver = a.solver == "explicit" ? Solver::Explicit : Solver::Implicit;
   o.mesh.mesher = a.mesher == "triangle" ? Mesher::triangle : Mesher::grid;
   if (!(a.edge >= 0.002 && a.edge <= 0.2)) throw InputError("--edge", "the edge length must be in [0.002, 0.2] m");
   o.mesh.edge_length = a.edge;
@@ -95,7 +97,7 @@ void run_dress(const DressArgs& a) {
   for (const GarmentRequest& r : requests)
     std::fprintf(stderr, " %s %s", r.spec.name.c_str(),
                  (r.size.empty() ? choose_size(r.spec, body.measurements).size : r.size).c_str());
-  std::fprintf(stderr, " (collision %s)\n", a.collision.c_str());
+  std::fprintf(stderr, " (collision %s, solver %s)\n", a.collision.c_str(), a.solver.c_str());
 
   Progress progress("dressing", 2.0 * static_cast<double>(requests.size()));
   // Per garment: sewing [0, 1), draping [1, 2); a coarse run (--coarse-edge) fills the sewing half
@@ -115,11 +117,11 @@ void run_dress(const DressArgs& a) {
   const FitQuality& q = result.quality;
   std::fprintf(stderr,
                "%s: %llu iterations in %.3f s (%.1f us each); max strain %.2f %%, seam gap max %.2f mm, "
-               "%zu vertices inside the body, %s\n",
+               "%zu vertices inside the body, residual %.3f, %s\n",
                result.passed() ? "dressed" : "FAILED quality gates",
                static_cast<unsigned long long>(result.simulation.iterations), result.simulation.wall_seconds,
                1e6 * result.simulation.seconds_per_iteration, 100.0 * q.max_strain, 1e3 * q.max_seam_gap_m,
-               q.penetrating_vertices, q.settled ? "settled" : "not settled");
+               q.penetrating_vertices, static_cast<double>(q.residual), q.settled ? "settled" : "not settled");
   if (q.skin_through.body_vertices > 0)
     std::fprintf(stderr, "skin shows through the cloth at %zu body vertices (up to %.1f mm; not a gate: report.json skin_through_cloth)\n",
                  q.skin_through.body_vertices, 1e3 * q.skin_through.max_depth_m);
@@ -157,6 +159,10 @@ void add_dress_command(CLI::App& app) {
                   "size to make (one for all garments, or one per --garment); default: the size whose size chart "
                   "entry is nearest to the body's measurements (docs/garment-format.md), report.json says why");
   cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own");
+  cmd->add_option("--solver", args->solver,
+                  "implicit (Newton on the incremental potential, quasi-static steps to equilibrium) or explicit "
+                  "(the paper's explicit Euler with velocity modification, sec. 3.3)")
+      ->capture_default_str()->check(CLI::IsMember({"implicit", "explicit"}));
   cmd->add_option("--collision", args->collision, "body collision: image (paper sec. 4.2), bvh (sec. 4.1) or sdf")
       ->capture_default_str()->check(CLI::IsMember({"image", "bvh", "sdf"}));
   cmd->add_option("--mesher", args->mesher, "grid (the paper's rectangular topology) or triangle")

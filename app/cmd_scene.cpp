@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "drape/cloth_scene.hpp"
+#include "drape/implicit.hpp"
 #include "drape/error.hpp"
 #include "drape/files.hpp"
 #include "drape/io.hpp"
@@ -133,7 +134,9 @@ void run_scene(const SceneArgs& a) {
                        {"max_penetration_m", q.max_penetration},
                        {"max_seam_gap_m", 0.0},
                        {"mean_seam_gap_m", 0.0},
-                       {"settled", run.settled}};
+                       {"settled", run.settled},
+                       {"residual", ImplicitSolver(scene.model, scene.colliders.size())
+                                        .residual(scene.state.x, scene.colliders, default_implicit_settings(scene.model))}};
   const auto per_iteration = [&](double total) { return run.iterations ? total / static_cast<double>(run.iterations) : 0.0; };
   report["simulation"] = {{"iterations", run.iterations},
                           {"time_step_s", dt},

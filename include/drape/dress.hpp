@@ -22,6 +22,7 @@
 #include "drape/fabric.hpp"
 #include "drape/fit.hpp"
 #include "drape/garment.hpp"
+#include "drape/implicit.hpp"
 #include "drape/scene.hpp"
 
 namespace drape {
@@ -30,6 +31,9 @@ namespace drape {
 inline constexpr double kPaperEdgeLength = 0.026;
 
 struct DressOptions {
+  // implicit: Newton on the incremental potential, quasi-static steps to equilibrium (drape/implicit.hpp);
+  // explicit: the paper's explicit Euler with velocity modification, and the settings below it uses.
+  Solver solver = Solver::Explicit;
   CollisionMethod collision = CollisionMethod::image;
   MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
   std::string fabric;  // empty: each garment's own
@@ -151,7 +155,9 @@ struct DressedGarment {
   float initial_max_gap = 0;   // m, right after placement (prepare_garment)
   float time_step = 0;         // s
   float placed_centre_y = 0, sewn_centre_y = 0, final_centre_y = 0;  // m, the centre of mass's height
-  StepProfile profile;
+  StepProfile profile;                // explicit solver
+  ImplicitProfile implicit_profile;   // implicit solver
+  float residual = 0;                 // largest |net force| / (m g) over the particles at the end
 
   // How far the centre of mass fell from where placement put the garment to the end (0 if it rose):
   // a garment that slid down the body. Measured from the placement, not from the end of sewing:
@@ -208,6 +214,10 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
 // Stages 5: sews then drapes `garment` on the colliders (body first, then dressed garments).
 void sew_and_drape(DressedGarment& garment, std::span<Collider* const> colliders, const DressOptions& options,
                    const DressProgressCallback& progress = {}, size_t index = 0, size_t count = 1);
+
+// Stage 5 with the implicit solver: quasi-static sewing, then draping to equilibrium (sew_implicit.cpp).
+void sew_and_drape_implicit(DressedGarment& garment, std::span<Collider* const> colliders, const DressOptions& options,
+                            const DressProgressCallback& progress = {}, size_t index = 0, size_t count = 1);
 
 // A dressed garment as a collider for the next layer: its surface pushed out by its thickness.
 std::unique_ptr<Collider> garment_collider(const DressedGarment& garment);

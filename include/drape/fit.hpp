@@ -52,6 +52,7 @@ struct FitQuality {
   float max_seam_gap_m = 0;
   float mean_seam_gap_m = 0;
   bool settled = false;
+  float residual = 0;  // largest |net force| / (m g) over the garments' particles at the end
   // Not in `quality` but gated:
   bool finite = true;             // no NaN / explosion
   float lowest_y = 0;             // m, lowest garment vertex (the floor is y = 0)

@@ -52,6 +52,7 @@ FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garm
     gap_sum += static_cast<double>(gaps.mean) * static_cast<double>(gaps.pairs);
     gap_pairs += gaps.pairs;
     q.settled = q.settled && g.settled;
+    q.residual = std::max(q.residual, g.residual);
     if (m.finite) {
       const SkinThroughStats skin = measure_skin_through(body.mesh, g.state.x, g.model.triangles);
       q.skin_through.body_vertices += skin.body_vertices;
@@ -104,7 +105,10 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
       result.simulation.iterations += g.coarse.iterations;
       result.simulation.wall_seconds += g.coarse.wall_seconds;
     }
-    sew_and_drape(g, colliders, o, progress, i, garments.size());
+    if (o.solver == Solver::Implicit)
+      sew_and_drape_implicit(g, colliders, o, progress, i, garments.size());
+    else
+      sew_and_drape(g, colliders, o, progress, i, garments.size());
     result.simulation.iterations += g.state.iterations;
     result.simulation.wall_seconds += g.sewing_seconds + g.drape_seconds;
     result.simulation.time_step_s = std::max(result.simulation.time_step_s, static_cast<double>(g.time_step));

@@ -74,6 +74,8 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"status", std::string(to_string(g.status))},
                         {"seams_closed", g.seams_closed},
                         {"settled", g.settled},
+                        {"residual", g.residual},
+                        {"newton_iterations", g.implicit_profile.newton_iterations},
                         {"initial_max_seam_gap_m", g.initial_max_gap},
                         {"max_seam_gap_m", gaps.max},
                         {"mean_seam_gap_m", gaps.mean},
@@ -111,7 +113,8 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
   extra["body"] = {{"vertices", body.mesh.vertex_count()},
                    {"triangles", body.mesh.triangle_count()},
                    {"height_m", body.measurements.height}};
-  extra["settings"] = {{"collision", std::string(to_string(o.collision))},
+  extra["settings"] = {{"solver", std::string(to_string(o.solver))},
+                       {"collision", std::string(to_string(o.collision))},
                        {"mesher", o.mesh.mesher == Mesher::grid ? "grid" : "triangle"},
                        {"edge_length_m", o.mesh.edge_length},
                        {"coarse_edge_length_m", o.coarse_edge},

@@ -1,4 +1,4 @@
-// report.json (DESIGN.md): `quality` with exactly its eight keys, `simulation`, `gates`, then the
+// report.json (DESIGN.md): `quality` with exactly its nine keys, `simulation`, `gates`, then the
 // caller's extra objects. Non-finite numbers become null (JSON has no NaN).
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -22,7 +22,8 @@ std::string report_json(const FitQuality& q, const SimulationSummary& s, const s
                        {"max_penetration_m", number(q.max_penetration_m)},
                        {"max_seam_gap_m", number(q.max_seam_gap_m)},
                        {"mean_seam_gap_m", number(q.mean_seam_gap_m)},
-                       {"settled", q.settled}};
+                       {"settled", q.settled},
+                       {"residual", number(q.residual)}};
   report["simulation"] = {{"iterations", s.iterations},
                           {"time_step_s", number(s.time_step_s)},
                           {"wall_seconds", number(s.wall_seconds)},

@@ -41,7 +41,7 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
   for (auto it = report["quality"].begin(); it != report["quality"].end(); ++it) keys.push_back(it.key());
   std::sort(keys.begin(), keys.end());
   EXPECT_EQ(keys, (std::vector<std::string>{"max_penetration_m", "max_seam_gap_m", "max_strain", "mean_seam_gap_m",
-                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "settled"}));
+                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "residual", "settled"}));
   for (const char* k : {"iterations", "time_step_s", "wall_seconds", "seconds_per_iteration"})
     EXPECT_TRUE(report["simulation"].contains(k)) << k;
   EXPECT_EQ(report["gates"]["passed"].get<bool>(), r.exit_code == 0);

@@ -256,7 +256,7 @@ TEST(Report, QualityHasExactlyTheContractKeys) {
   for (auto it = r["quality"].begin(); it != r["quality"].end(); ++it) keys.push_back(it.key());
   std::sort(keys.begin(), keys.end());
   EXPECT_EQ(keys, (std::vector<std::string>{"max_penetration_m", "max_seam_gap_m", "max_strain", "mean_seam_gap_m",
-                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "settled"}));
+                                            "p99_strain", "penetrating_vertices", "penetration_fraction", "residual", "settled"}));
   EXPECT_EQ(r["simulation"]["iterations"], 120);
   EXPECT_TRUE(r["simulation"].contains("time_step_s"));
   EXPECT_TRUE(r["simulation"].contains("wall_seconds"));

@@ -94,9 +94,9 @@ TEST(SceneCommand, WritesTheReportWithDesignKeys) {
   std::ifstream in(dir / "report.json");
   const nlohmann::json report = nlohmann::json::parse(in);
   for (const char* key : {"max_strain", "p99_strain", "penetrating_vertices", "penetration_fraction", "max_penetration_m",
-                          "max_seam_gap_m", "mean_seam_gap_m", "settled"})
+                          "max_seam_gap_m", "mean_seam_gap_m", "settled", "residual"})
     EXPECT_TRUE(report["quality"].contains(key)) << key;
-  EXPECT_EQ(report["quality"].size(), 8u);
+  EXPECT_EQ(report["quality"].size(), 9u);
   for (const char* key : {"iterations", "time_step_s", "wall_seconds", "seconds_per_iteration"})
     EXPECT_TRUE(report["simulation"].contains(key)) << key;
   EXPECT_TRUE(report["quality"]["settled"].get<bool>());

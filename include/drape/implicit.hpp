@@ -1,0 +1,88 @@
+#pragma once
+// The implicit solver: each step minimises the incremental potential of the particle system
+//
+//   E(x) = sum_i m_i / (2 h^2) |x_i - y_i|^2          inertia (y = x_n + h v_n; at rest: y = x_n)
+//        + sum_springs k / 2 (|x_b - x_a| - l0)^2       stretch, shear, bending, elastic bands
+//        + sum_structural k_lim / 2 (l - (1 + s) l0)^2_+ the strain limit, a stiff barrier at the
+//                                                       fabric's threshold s
+//        + sum_seams  seam(|x_b - x_a|)                 zero-length seams (force-capped while sewing)
+//        + sum_i k_c,i / 2 (t - d_i(x_i))^2_+           contact: a penalty inside the thickness t
+//        + sum_i mu lambda_i f(|T_i (x_i - x_n,i)|)     Coulomb friction, lagged (IPC's smoothing)
+//        - sum_i m_i g . x_i                            gravity
+//
+// by Newton's method (Baraff & Witkin 1998 without their one-iteration shortcut): a spring's
+// Hessian made positive semi-definite by dropping its compressive transverse term, the sparse
+// system solved directly (Cholesky with a fill-reducing ordering analysed once per model: the
+// pattern never changes), a backtracking line search on E, and a cap on how far one iteration
+// moves a particle so contacts found at the start of an iteration stay valid for it. Contacts are
+// found anew every iteration, as tangent planes of the nearest collider surface.
+//
+// Two modes: dynamic (implicit Euler; stable at steps of 1/30 s and longer) and quasi-static
+// (every step starts at rest, so the inertia term is only a proximal term: the steps walk down E
+// to the state of rest, which is what dressing wants). See docs/cloth.md.
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "drape/cloth.hpp"
+
+namespace drape {
+
+enum class Solver : uint8_t { Explicit, Implicit };
+std::string_view to_string(Solver solver);
+
+struct ImplicitSettings {
+  double time_step = 1.0 / 30.0;        // s
+  bool quasi_static = false;            // every step starts at rest (draping to equilibrium)
+  bool moving_colliders = false;        // colliders move or deform: every contact found anew each step
+  Vec3f gravity{0.0f, -9.81f, 0.0f};    // m/s^2
+  float friction = 0.3f;                // Coulomb coefficient against colliders
+  float strain_threshold = 0.05f;       // structural stretch at which the limit's barrier starts
+  float seam_stiffness = 2000.0f;       // N/m per sewn pair (a closed seam's zero-length spring)
+  float seam_force = 0.0f;              // N, the most one pair pulls with (sewing); 0: no cap
+  float max_move = 0.01f;               // m, the most one Newton iteration moves a particle
+};
+// Settings from the model's fabric (friction, threshold).
+ImplicitSettings default_implicit_settings(const ClothModel& model);
+
+// What one step did.
+struct ImplicitStepStats {
+  int newton_iterations = 0;
+  float max_move = 0;      // m, the largest displacement of a particle over the step
+  float residual = 0;      // largest |net force| / (m g) at the end of the step (inertia excluded)
+  uint32_t contacts = 0;   // particles within the contact thickness at the end
+  bool converged = false;  // Newton's last iteration moved no particle more than the tolerance
+};
+
+// Wall-clock seconds per stage of the implicit step, summed over steps.
+struct ImplicitProfile {
+  double contacts = 0, assemble = 0, factorize = 0, solve = 0, line_search = 0;
+  uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
+  double total_seconds() const { return contacts + assemble + factorize + solve + line_search; }
+};
+
+// The solver for one model: its sparse pattern and ordering are analysed once, at construction;
+// step() allocates nothing. The model is read, never changed; everything carried from step to step
+// is in the ClothState.
+class ImplicitSolver {
+ public:
+  explicit ImplicitSolver(const ClothModel& model, size_t max_colliders = 4);
+  ~ImplicitSolver();
+  ImplicitSolver(ImplicitSolver&&) noexcept;
+  ImplicitSolver& operator=(ImplicitSolver&&) noexcept;
+
+  // One step of h = settings.time_step. Colliders are brought to the new time first. Returns the
+  // state's status (sticky, as for the explicit step).
+  StepStatus step(ClothState& state, std::span<Collider* const> colliders, const ImplicitSettings& settings,
+                  ImplicitStepStats* stats = nullptr, ImplicitProfile* profile = nullptr);
+
+  // The largest |net force| / (m g) over the free particles at `x` (inertia excluded, friction
+  // taking up to mu times the normal force of the tangential force), with contacts found now.
+  float residual(std::span<const Vec3f> x, std::span<Collider* const> colliders, const ImplicitSettings& settings);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drape

@@ -1,0 +1,110 @@
+// Stage 5 with the implicit solver (drape/implicit.hpp, docs/dressing.md): the same two phases as
+// the paper's sec. 6.2, each a walk to a state of rest by quasi-static steps.
+//
+// Sewing: no gravity, frictionless contact, every seam pair pulled together by a force of at most
+// kSewingForce (a constant pull from afar, a stiff zero-length spring once close), until every pair
+// is within seam_closed_m. Draping: gravity and the fabric's friction on, the seams stiff
+// zero-length springs, until the largest net force on a particle is at most kResidual of its
+// weight. Settled: then a continued dynamic simulation of settle_window_s (implicit Euler at
+// 1/30 s, from rest) moves no particle more than settle_distance_m.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "drape/dress.hpp"
+#include "drape/implicit.hpp"
+
+namespace drape {
+namespace {
+
+constexpr double kQuasiStaticStep = 0.05;  // s, the proximal term's time scale
+constexpr double kDynamicStep = 1.0 / 30.0;
+constexpr float kSewingForce = 0.05f;      // N, the most one seam pair pulls with while sewing
+constexpr float kResidual = 0.01f;         // equilibrium: |net force| <= 1 % of a particle's weight
+constexpr int kMaxSewingSteps = 200;
+constexpr int kMaxDrapeSteps = 200;
+
+float centre_height(const ClothModel& m, const std::vector<Vec3f>& x) {
+  double c = 0, total = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    c += static_cast<double>(m.mass[i]) * x[i].y();
+    total += m.mass[i];
+  }
+  return total > 0 ? static_cast<float>(c / total) : 0.0f;
+}
+
+float widest_gap(const ClothState& s, std::span<const std::array<uint32_t, 2>> pairs) {
+  float widest = 0;
+  for (const auto& [a, b] : pairs) widest = std::max(widest, (s.x[a] - s.x[b]).norm());
+  return widest;
+}
+
+}  // namespace
+
+void sew_and_drape_implicit(DressedGarment& g, std::span<Collider* const> colliders, const DressOptions& o,
+                            const DressProgressCallback& progress, size_t index, size_t count) {
+  g.placed_centre_y = g.sewn_centre_y = g.final_centre_y = centre_height(g.model, g.state.x);
+  g.time_step = static_cast<float>(kQuasiStaticStep);
+  if (!o.simulate) return;
+  ImplicitSolver solver(g.model, std::max<size_t>(colliders.size(), 1));
+  ImplicitSettings s = default_implicit_settings(g.model);
+  s.time_step = kQuasiStaticStep;
+  s.quasi_static = true;
+  const uint64_t cap = o.max_iterations ? o.max_iterations : std::numeric_limits<uint64_t>::max();
+  ImplicitStepStats stats;
+  const auto report = [&](const char* phase, double limit) {
+    if (progress) progress({index, count, phase, g.state.iterations, g.state.time, limit});
+  };
+
+  // Sewing.
+  auto start = std::chrono::steady_clock::now();
+  s.gravity = Vec3f::Zero();
+  s.friction = 0.0f;
+  s.seam_force = kSewingForce;
+  g.seams_closed = widest_gap(g.state, g.seam_pairs) <= o.seam_closed_m;
+  for (int k = 0; k < kMaxSewingSteps && !g.seams_closed && g.state.iterations < cap; ++k) {
+    g.status = solver.step(g.state, colliders, s, &stats, &g.implicit_profile);
+    if (g.status != StepStatus::Ok) break;
+    g.seams_closed = widest_gap(g.state, g.seam_pairs) <= o.seam_closed_m;
+    report("sewing", kMaxSewingSteps * kQuasiStaticStep);
+  }
+  g.sewing_iterations = g.state.iterations;
+  g.sewing_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  g.sewn_max_strain = strain_stats(g.model, g.state.x).max;
+  g.sewn_centre_y = centre_height(g.model, g.state.x);
+
+  // Draping.
+  start = std::chrono::steady_clock::now();
+  s.gravity = Vec3f(0.0f, -9.81f, 0.0f);
+  s.friction = g.model.fabric.friction;
+  s.seam_force = 0.0f;
+  g.residual = std::numeric_limits<float>::infinity();
+  const uint64_t drape_start = g.state.iterations;
+  for (int k = 0; k < kMaxDrapeSteps && g.status == StepStatus::Ok && g.state.iterations < cap; ++k) {
+    g.status = solver.step(g.state, colliders, s, &stats, &g.implicit_profile);
+    g.residual = stats.residual;
+    report("draping", kMaxDrapeSteps * kQuasiStaticStep);
+    if (g.status != StepStatus::Ok || (stats.converged && stats.residual <= kResidual)) break;
+  }
+  // Settled: a continued dynamic simulation from rest hardly moves it. The continuation is a test
+  // of the state of rest, which is what the garment keeps.
+  g.settled = false;
+  if (g.status == StepStatus::Ok && g.residual <= kResidual) {
+    ClothState trial = g.state;
+    s.quasi_static = false;
+    s.time_step = kDynamicStep;
+    StepStatus status = StepStatus::Ok;
+    const int steps = std::max(1, static_cast<int>(std::lround(o.settle_window_s / kDynamicStep)));
+    for (int k = 0; k < steps && status == StepStatus::Ok; ++k)
+      status = solver.step(trial, colliders, s, nullptr, &g.implicit_profile);
+    float moved = 0;
+    for (size_t i = 0; i < trial.x.size(); ++i) moved = std::max(moved, (trial.x[i] - g.state.x[i]).norm());
+    g.settled = status == StepStatus::Ok && moved <= o.settle_distance_m;
+  }
+  g.seams_closed = widest_gap(g.state, g.seam_pairs) <= o.seam_closed_m;
+  g.drape_iterations = g.state.iterations - drape_start;
+  g.drape_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  g.final_centre_y = centre_height(g.model, g.state.x);
+}
+
+}  // namespace drape

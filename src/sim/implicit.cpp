@@ -1,0 +1,651 @@
+// The implicit solver (include/drape/implicit.hpp, docs/cloth.md): Newton's method on the
+// incremental potential, one sparse Cholesky factorisation per iteration over a pattern analysed
+// once.
+//
+// Assembly is deterministic on any number of threads: every spring's gradient and Hessian block
+// are computed in parallel into per-spring slots, then gathered per particle (diagonal blocks and
+// gradient, over the model's fixed incidence order) and per off-diagonal block (over a fixed list of
+// the springs that share it). Energies are summed per fixed block of items, the blocks in order.
+#include "drape/implicit.hpp"
+
+// GCC 12 sees a null dereference in Eigen's sparse views when it inlines them into the CHOLMOD
+// wrapper (an empty matrix's index pointers, never read): a false positive inside the library.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wnull-dereference"
+#include <Eigen/CholmodSupport>
+#include <Eigen/Sparse>
+#pragma GCC diagnostic pop
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "sim/parallel.hpp"
+
+namespace drape {
+namespace {
+
+using Mat3d = Eigen::Matrix3d;
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// The strain limit's barrier is this many times stiffer than the spring it limits: a structural
+// spring pulled by ten times the force that stretches it to the threshold s goes past it by 0.09 s
+// (0.45 % at s = 5 %), within the gates' 1 % tolerance.
+constexpr double kLimitStiffness = 100.0;
+// Contact penalty per square metre of cloth a particle represents (N/m per m^2): a pressure of
+// 100 Pa per millimetre inside the thickness layer. Hanging cloth presses with its weight, ~1.5 Pa;
+// a garment at its strain limit round a 5 cm limb with ~200 Pa: both stay within the layer.
+constexpr double kContactStiffnessPerArea = 1e5;
+// Friction's smoothing (IPC): tangential slip below this per step is resisted like a stiff spring
+// (static friction), above it by the full Coulomb force.
+constexpr double kFrictionSlip = 1e-4;  // m
+// A contact plane is found anew once its particle moved this far from where it was found.
+constexpr double kReplane = 1e-3;  // m
+// Newton stops when no particle's net force (inertia included) exceeds this fraction of its weight,
+// or when an iteration moved no particle more than kStagnation.
+constexpr double kNewtonForceTolerance = 0.002;
+constexpr double kStagnation = 1e-8;  // m
+constexpr int kMaxNewtonIterations = 12;
+// Inexact Newton: the direction solves the system to this relative residual.
+constexpr double kPcgTolerance = 1e-3;
+constexpr int kMaxPcgIterations = 16;
+constexpr int kMaxHalvings = 12;
+constexpr double kArmijo = 1e-4;
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Adds `seconds since the last mark` to a profile field.
+class Timer {
+ public:
+  explicit Timer(bool on) : on_(on), last_(on ? now() : 0) {}
+  void mark(double& into) {
+    if (!on_) return;
+    const double t = now();
+    into += t - last_;
+    last_ = t;
+  }
+
+ private:
+  bool on_;
+  double last_;
+};
+
+// The spring of (a, b): energy, force on b (a gets its negative) and its Hessian block, made
+// positive semi-definite (the transverse term of a compressed spring dropped).
+struct SpringTerm {
+  double energy = 0;
+  Vec3d gradient_b = Vec3d::Zero();  // dE/dx_b; dE/dx_a = -dE/dx_b
+  Mat3d hessian = Mat3d::Zero();     // d2E/dx_b2 = d2E/dx_a2 = -d2E/dx_a dx_b
+};
+
+// k/2 (l - rest)^2.
+inline void add_spring(SpringTerm& t, const Vec3d& d, double l, double rest, double k) {
+  if (k <= 0) return;
+  if (l < 1e-12) {
+    t.hessian.diagonal().array() += k;
+    t.energy += 0.5 * k * rest * rest;
+    return;
+  }
+  const Vec3d u = d / l;
+  t.energy += 0.5 * k * (l - rest) * (l - rest);
+  t.gradient_b += k * (l - rest) * u;
+  const double transverse = std::max(0.0, 1.0 - rest / l);
+  t.hessian += k * (transverse * Mat3d::Identity() + (1.0 - transverse) * u * u.transpose());
+}
+
+// Zero-length seam: k/2 l^2 up to the length where it pulls with `cap`, then a constant pull of
+// `cap` (its Hessian: the zero-length spring that pulls with `cap` at this length).
+inline void add_seam(SpringTerm& t, const Vec3d& d, double l, double k, double cap) {
+  if (cap > 0 && k * l > cap) {
+    const double reach = cap / k;
+    t.energy += cap * (l - 0.5 * reach);
+    t.gradient_b += (cap / l) * d;
+    t.hessian.diagonal().array() += cap / l;
+    return;
+  }
+  t.energy += 0.5 * k * l * l;
+  t.gradient_b += k * d;
+  t.hessian.diagonal().array() += k;
+}
+
+}  // namespace
+
+std::string_view to_string(Solver solver) { return solver == Solver::Explicit ? "explicit" : "implicit"; }
+
+ImplicitSettings default_implicit_settings(const ClothModel& model) {
+  ImplicitSettings s;
+  s.friction = model.fabric.friction;
+  s.strain_threshold = model.fabric.strain_threshold;
+  return s;
+}
+
+struct ImplicitSolver::Impl {
+  const ClothModel& model;
+  size_t n = 0;
+  std::vector<uint8_t> free;          // per particle: 1 unless pinned
+  std::vector<double> contact_k;      // per particle: contact penalty stiffness (N/m)
+
+  // Sparse pattern: block offsets into the matrix's values. Block b's column k (0..2) starts at
+  // values[block_offset[3 b + k]] (its three rows follow). Blocks 0..n-1 are the diagonal.
+  SparseMatrix matrix;
+  std::vector<int> block_offset;
+  std::vector<uint32_t> spring_block;          // per spring: its (a, b) block; (b, a) is spring_block_t
+  std::vector<uint32_t> spring_block_t;
+  // Off-diagonal blocks and the springs that share each (CSR, in spring order).
+  std::vector<uint32_t> offdiag_begin, offdiag_spring, offdiag_block, offdiag_block_t;
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky;
+
+  // Per step and iteration (allocated once).
+  std::vector<Vec3d> x, x0, y, trial;     // positions now, at the step start, inertial target, trial
+  std::vector<Vec3d> detected_at;         // positions where the contacts were found
+  std::vector<Vec3f> xf;                  // float positions for the colliders
+  std::vector<ContactSample> sample, sample_tmp;
+  std::vector<Vec3d> plane_normal;        // per particle: contact plane d(x) = n.x + c
+  std::vector<double> plane_offset;
+  std::vector<uint8_t> in_range;          // a surface within the query radius
+  std::vector<double> friction_force;     // per particle: lagged normal force x mu (N)
+  std::vector<Vec3d> surface_velocity;
+  std::vector<SpringTerm> spring_term;
+  Eigen::VectorXd gradient, direction;
+  std::vector<double> block_sum;
+  double force_ratio = 0;  // after assemble(): the largest |gradient_i| / (m_i g)
+  size_t max_colliders = 0;
+  bool analysed = false;  // the ordering and symbolic factorisation, at the first step
+  bool factored = false;
+  bool planes_valid = false;  // contact planes found at least once  // the factorisation holds a matrix of this step
+  Eigen::VectorXd residual_vec, search, product, preconditioned;  // conjugate gradients
+  bool preconditioned_solve();
+
+  Impl(const ClothModel& m, size_t colliders);
+  void analyse_pattern();
+  // Contact planes refreshed where needed (see detect_contacts), and friction's normal forces.
+  void detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h, bool refresh_all);
+  void lag_friction(const ImplicitSettings& s);
+  std::vector<uint32_t> refresh;  // particles whose contacts are being refreshed
+  double energy(const std::vector<Vec3d>& at, const ImplicitSettings& s, double h);
+  void spring_terms(const ImplicitSettings& s);
+  void assemble(const ImplicitSettings& s, double h);
+  float residual(const ImplicitSettings& s);
+};
+
+ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(m.particle_count()) {
+  free.resize(n);
+  contact_k.resize(n);
+  const double density = std::max(1e-6, static_cast<double>(m.fabric.areal_density));
+  for (size_t i = 0; i < n; ++i) {
+    free[i] = m.inverse_mass[i] > 0 ? 1 : 0;
+    const double area = m.drag_area.size() == n && m.drag_area[i] > 0 ? m.drag_area[i] : m.mass[i] / density;
+    contact_k[i] = kContactStiffnessPerArea * area;
+  }
+  analyse_pattern();
+  x.resize(n);
+  x0.resize(n);
+  y.resize(n);
+  trial.resize(n);
+  detected_at.resize(n);
+  refresh.resize(n);
+  xf.resize(n);
+  sample.resize(n);
+  sample_tmp.resize(colliders > 1 ? n : 0);  // indexed by position in `refresh`, like sample
+  plane_normal.assign(n, Vec3d::UnitY());
+  plane_offset.assign(n, 0.0);
+  in_range.assign(n, 0);
+  friction_force.assign(n, 0.0);
+  surface_velocity.assign(n, Vec3d::Zero());
+  spring_term.resize(m.spring_count());
+  for (Eigen::VectorXd* v : {&gradient, &direction, &residual_vec, &search, &product, &preconditioned})
+    v->setZero(static_cast<Eigen::Index>(3 * n));
+  block_sum.assign(std::max(sim::block_count(n), sim::block_count(m.spring_count())), 0.0);
+  max_colliders = colliders;
+}
+
+void ImplicitSolver::Impl::analyse_pattern() {
+  const size_t springs = model.spring_count();
+  // Off-diagonal blocks: one per distinct (a, b) pair with a < b, in first-spring order.
+  std::vector<std::array<uint32_t, 3>> keyed(springs);  // min, max, spring
+  for (size_t s = 0; s < springs; ++s) {
+    const uint32_t a = model.spring_a[s], b = model.spring_b[s];
+    keyed[s] = {std::min(a, b), std::max(a, b), static_cast<uint32_t>(s)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::array<uint32_t, 2>> blocks;  // (row particle, column particle): diagonal first
+  blocks.reserve(n + 2 * springs);
+  for (size_t i = 0; i < n; ++i) blocks.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(i)});
+  spring_block.assign(springs, 0);
+  spring_block_t.assign(springs, 0);
+  offdiag_begin.clear();
+  offdiag_spring.clear();
+  offdiag_block.clear();
+  offdiag_block_t.clear();
+  for (size_t k = 0; k < keyed.size(); ++k) {
+    const auto [lo, hi, s] = keyed[k];
+    if (lo == hi) continue;  // a spring from a particle to itself has no force
+    if (k == 0 || keyed[k - 1][0] != lo || keyed[k - 1][1] != hi) {
+      offdiag_begin.push_back(static_cast<uint32_t>(offdiag_spring.size()));
+      offdiag_block.push_back(static_cast<uint32_t>(blocks.size()));
+      blocks.push_back({lo, hi});
+      offdiag_block_t.push_back(static_cast<uint32_t>(blocks.size()));
+      blocks.push_back({hi, lo});
+    }
+    offdiag_spring.push_back(s);
+  }
+  offdiag_begin.push_back(static_cast<uint32_t>(offdiag_spring.size()));
+
+  std::vector<Eigen::Triplet<double, int>> triplets;
+  triplets.reserve(9 * blocks.size());
+  for (const auto& [r, c] : blocks)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) triplets.emplace_back(static_cast<int>(3 * r) + i, static_cast<int>(3 * c) + j, 1.0);
+  matrix.resize(static_cast<int>(3 * n), static_cast<int>(3 * n));
+  matrix.setFromTriplets(triplets.begin(), triplets.end());
+  matrix.makeCompressed();
+  block_offset.assign(3 * blocks.size(), 0);
+  const int* outer = matrix.outerIndexPtr();
+  const int* inner = matrix.innerIndexPtr();
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const auto [r, c] = blocks[b];
+    for (int k = 0; k < 3; ++k) {
+      const int col = static_cast<int>(3 * c) + k;
+      const int* found = std::lower_bound(inner + outer[col], inner + outer[col + 1], static_cast<int>(3 * r));
+      block_offset[3 * b + static_cast<size_t>(k)] = static_cast<int>(found - inner);
+    }
+  }
+}
+
+void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h,
+                                           bool refresh_all) {
+  const float thickness = model.fabric.collision_thickness;
+  const float radius = thickness + 2.0f * s.max_move;
+  // The particles to ask about, in index order.
+  size_t count = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!free[i]) continue;
+    const double reach = in_range[i] ? kReplane : static_cast<double>(s.max_move);
+    if (refresh_all || (x[i] - detected_at[i]).squaredNorm() > reach * reach) {
+      refresh[count] = static_cast<uint32_t>(i);
+      xf[count] = x[i].cast<float>();
+      detected_at[i] = x[i];
+      ++count;
+    }
+  }
+  sim::parallel_blocks(count, [&](size_t, size_t begin, size_t end) {
+    const size_t chunk = end - begin;
+    const std::span<const Vec3f> points(xf.data() + begin, chunk);
+    const std::span<ContactSample> nearest(sample.data() + begin, chunk);
+    if (colliders.empty()) {
+      for (ContactSample& c : nearest) c.distance = std::numeric_limits<float>::infinity();
+    } else {
+      colliders[0]->query(points, radius, nearest);
+      for (size_t k = 1; k < colliders.size(); ++k) {
+        const std::span<ContactSample> other(sample_tmp.data() + begin, chunk);
+        colliders[k]->query(points, radius, other);
+        for (size_t q = 0; q < chunk; ++q)
+          if (other[q].distance < nearest[q].distance) nearest[q] = other[q];
+      }
+    }
+    for (size_t q = begin; q < end; ++q) {
+      const size_t i = refresh[q];
+      const ContactSample& c = sample[q];
+      in_range[i] = c.distance < radius ? 1 : 0;
+      if (!in_range[i]) continue;
+      plane_normal[i] = c.normal.cast<double>().normalized();
+      plane_offset[i] = static_cast<double>(c.distance) - plane_normal[i].dot(x[i]);
+      surface_velocity[i] = c.velocity.cast<double>() * h;  // the surface's displacement over the step
+    }
+  });
+}
+
+void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s) {
+  const double thickness = model.fabric.collision_thickness, mu = std::max(0.0f, s.friction);
+  for (size_t i = 0; i < n; ++i)
+    friction_force[i] = in_range[i] ? mu * contact_k[i] * std::max(0.0, thickness - (plane_normal[i].dot(x[i]) + plane_offset[i])) : 0.0;
+}
+
+double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const ImplicitSettings& s, double h) {
+  const ClothModel& m = model;
+  const double inv_h2 = 1.0 / (h * h);
+  const Vec3d g = s.gravity.cast<double>();
+  const double thickness = m.fabric.collision_thickness;
+  const SpringRange structural = m.range(SpringKind::Structural), seams = m.range(SpringKind::Seam);
+  const double limit = 1.0 + s.strain_threshold;
+  // Particles: inertia, gravity, contact, friction.
+  double total = 0;
+  const size_t pblocks = sim::block_count(n);
+  sim::parallel_blocks(n, [&](size_t b, size_t begin, size_t end) {
+    double e = 0;
+    for (size_t i = begin; i < end; ++i) {
+      if (!free[i]) continue;
+      e += 0.5 * m.inertial_mass(i) * inv_h2 * (at[i] - y[i]).squaredNorm() - m.mass[i] * g.dot(at[i]);
+      if (!in_range[i]) continue;
+      const double pen = thickness - (plane_normal[i].dot(at[i]) + plane_offset[i]);
+      if (pen > 0) e += 0.5 * contact_k[i] * pen * pen;
+      if (friction_force[i] > 0) {
+        Vec3d u = at[i] - x0[i] - surface_velocity[i];
+        u -= plane_normal[i].dot(u) * plane_normal[i];
+        const double slip = u.norm();
+        e += friction_force[i] * (slip < kFrictionSlip ? 0.5 * slip * slip / kFrictionSlip : slip - 0.5 * kFrictionSlip);
+      }
+    }
+    block_sum[b] = e;
+  });
+  for (size_t b = 0; b < pblocks; ++b) total += block_sum[b];
+  // Springs.
+  const size_t springs = m.spring_count();
+  sim::parallel_blocks(springs, [&](size_t b, size_t begin, size_t end) {
+    double e = 0;
+    for (size_t k = begin; k < end; ++k) {
+      const Vec3d d = at[m.spring_b[k]] - at[m.spring_a[k]];
+      const double l = d.norm();
+      if (k >= seams.begin && k < seams.end) {
+        const double ks = s.seam_stiffness, cap = s.seam_force;
+        e += cap > 0 && ks * l > cap ? cap * (l - 0.5 * cap / ks) : 0.5 * ks * l * l;
+        continue;
+      }
+      const double rest = m.rest_length[k], stiff = m.stiffness[k];
+      e += 0.5 * stiff * (l - rest) * (l - rest);
+      if (k >= structural.begin && k < structural.end) {
+        const double over = l - limit * rest;
+        if (over > 0) e += 0.5 * kLimitStiffness * stiff * over * over;
+      }
+    }
+    block_sum[b] = e;
+  });
+  for (size_t b = 0; b < sim::block_count(springs); ++b) total += block_sum[b];
+  return total;
+}
+
+void ImplicitSolver::Impl::spring_terms(const ImplicitSettings& s) {
+  const ClothModel& m = model;
+  const SpringRange structural = m.range(SpringKind::Structural), seams = m.range(SpringKind::Seam);
+  const double limit = 1.0 + s.strain_threshold;
+  sim::parallel_blocks(m.spring_count(), [&](size_t, size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      SpringTerm& t = spring_term[k];
+      t = SpringTerm{};
+      const Vec3d d = x[m.spring_b[k]] - x[m.spring_a[k]];
+      const double l = d.norm();
+      if (k >= seams.begin && k < seams.end) {
+        add_seam(t, d, l, s.seam_stiffness, s.seam_force);
+        continue;
+      }
+      const double rest = m.rest_length[k], stiff = m.stiffness[k];
+      add_spring(t, d, l, rest, stiff);
+      if (k >= structural.begin && k < structural.end && l > limit * rest)
+        add_spring(t, d, l, limit * rest, kLimitStiffness * stiff);
+    }
+  });
+}
+
+void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
+  const ClothModel& m = model;
+  const double inv_h2 = 1.0 / (h * h);
+  const Vec3d g = s.gravity.cast<double>();
+  const double thickness = m.fabric.collision_thickness;
+  double* values = matrix.valuePtr();
+  const auto set_block = [&](uint32_t block, const Mat3d& a) {
+    for (int k = 0; k < 3; ++k) {
+      double* col = values + block_offset[3 * block + static_cast<size_t>(k)];
+      for (int r = 0; r < 3; ++r) col[r] = a(r, k);
+    }
+  };
+  spring_terms(s);
+  // Per particle: diagonal block and gradient (springs in the model's incidence order).
+  const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
+  sim::parallel_blocks(n, [&](size_t b, size_t begin, size_t end) {
+    double ratio = 0;
+    for (size_t i = begin; i < end; ++i) {
+      Vec3d grad = Vec3d::Zero();
+      Mat3d diag = Mat3d::Zero();
+      if (free[i]) {
+        const double mi = m.inertial_mass(i) * inv_h2;
+        grad += mi * (x[i] - y[i]) - static_cast<double>(m.mass[i]) * g;
+        diag.diagonal().array() += mi;
+        for (uint32_t q = m.incident_begin[i]; q < m.incident_begin[i + 1]; ++q) {
+          const SpringTerm& t = spring_term[m.incident_spring[q]];
+          grad -= static_cast<double>(m.incident_sign[q]) * t.gradient_b;  // sign +1: i is the a end
+          diag += t.hessian;
+        }
+        if (in_range[i]) {
+          const Vec3d& nrm = plane_normal[i];
+          const double pen = thickness - (nrm.dot(x[i]) + plane_offset[i]);
+          if (pen > 0) {
+            grad -= contact_k[i] * pen * nrm;
+            diag += contact_k[i] * nrm * nrm.transpose();
+          }
+          if (friction_force[i] > 0) {
+            const Mat3d tangent = Mat3d::Identity() - nrm * nrm.transpose();
+            const Vec3d u = tangent * (x[i] - x0[i] - surface_velocity[i]);
+            const double slip = u.norm();
+            const double scale = slip < kFrictionSlip ? friction_force[i] / kFrictionSlip : friction_force[i] / slip;
+            grad += scale * u;
+            diag += scale * tangent;
+          }
+        }
+      } else {
+        diag = Mat3d::Identity();
+      }
+      gradient.segment<3>(static_cast<Eigen::Index>(3 * i)) = grad;
+      set_block(static_cast<uint32_t>(i), diag);
+      ratio = std::max(ratio, grad.norm() / (static_cast<double>(m.mass[i]) * gscale));
+    }
+    block_sum[b] = ratio;
+  });
+  force_ratio = 0;
+  for (size_t b = 0; b < sim::block_count(n); ++b) force_ratio = std::max(force_ratio, block_sum[b]);
+  // Off-diagonal blocks: -sum of the springs sharing them, zero where an end is pinned.
+  sim::parallel_blocks(offdiag_block.size(), [&](size_t, size_t begin, size_t end) {
+    for (size_t q = begin; q < end; ++q) {
+      Mat3d sum = Mat3d::Zero();
+      uint32_t a = 0, b = 0;
+      for (uint32_t j = offdiag_begin[q]; j < offdiag_begin[q + 1]; ++j) {
+        const uint32_t k = offdiag_spring[j];
+        sum -= spring_term[k].hessian;
+        a = m.spring_a[k];
+        b = m.spring_b[k];
+      }
+      if (!free[a] || !free[b]) sum.setZero();
+      set_block(offdiag_block[q], sum);
+      set_block(offdiag_block_t[q], sum.transpose());
+    }
+  });
+}
+
+bool ImplicitSolver::Impl::preconditioned_solve() {
+  Eigen::VectorXd& d = direction;
+  Eigen::VectorXd& r = residual_vec;
+  d.setZero();
+  r = -gradient;
+  const double target = kPcgTolerance * r.norm();
+  preconditioned = cholesky.solve(r);
+  search = preconditioned;
+  double rz = r.dot(preconditioned);
+  for (int k = 0; k < kMaxPcgIterations; ++k) {
+    product.noalias() = matrix * search;
+    const double curvature = search.dot(product);
+    if (!(curvature > 0)) return false;
+    const double step = rz / curvature;
+    d += step * search;
+    r -= step * product;
+    if (r.norm() <= target) return true;
+    preconditioned = cholesky.solve(r);
+    const double rz_next = r.dot(preconditioned);
+    search = preconditioned + (rz_next / rz) * search;
+    rz = rz_next;
+  }
+  return false;
+}
+
+float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
+  // Net force per particle: springs, seams, gravity, contact, and static friction up to mu N.
+  const ClothModel& m = model;
+  const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
+  const double thickness = m.fabric.collision_thickness;
+  const double mu = std::max(0.0f, s.friction);
+  spring_terms(s);
+  const Vec3d gravity = s.gravity.cast<double>();
+  float worst = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!free[i]) continue;
+    Vec3d force = static_cast<double>(m.mass[i]) * gravity;
+    for (uint32_t q = m.incident_begin[i]; q < m.incident_begin[i + 1]; ++q)
+      force += static_cast<double>(m.incident_sign[q]) * spring_term[m.incident_spring[q]].gradient_b;
+    if (in_range[i]) {
+      const Vec3d& nrm = plane_normal[i];
+      const double pen = thickness - (nrm.dot(x[i]) + plane_offset[i]);
+      const double normal_force = contact_k[i] * std::max(0.0, pen);
+      force += normal_force * nrm;
+      if (normal_force > 0) {
+        // Static friction takes up to mu N of the tangential force.
+        const Vec3d tangential = force - nrm.dot(force) * nrm;
+        const double t = tangential.norm();
+        if (t > 0) force -= tangential * (std::min(t, mu * normal_force) / t);
+      }
+    }
+    const float r = static_cast<float>(force.norm() / (static_cast<double>(m.mass[i]) * gscale));
+    worst = std::max(worst, r);
+  }
+  return worst;
+}
+
+ImplicitSolver::ImplicitSolver(const ClothModel& model, size_t max_colliders)
+    : impl_(std::make_unique<Impl>(model, std::max<size_t>(max_colliders, 1))) {}
+ImplicitSolver::~ImplicitSolver() = default;
+ImplicitSolver::ImplicitSolver(ImplicitSolver&&) noexcept = default;
+ImplicitSolver& ImplicitSolver::operator=(ImplicitSolver&&) noexcept = default;
+
+float ImplicitSolver::residual(std::span<const Vec3f> x, std::span<Collider* const> colliders,
+                               const ImplicitSettings& settings) {
+  Impl& w = *impl_;
+  if (x.size() != w.n) throw std::invalid_argument("ImplicitSolver::residual: positions not made for this model");
+  for (size_t i = 0; i < w.n; ++i) w.x[i] = w.x0[i] = x[i].cast<double>();
+  w.detect_contacts(colliders, settings, settings.time_step, true);
+  w.planes_valid = true;
+  return w.residual(settings);
+}
+
+StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> colliders,
+                                const ImplicitSettings& s, ImplicitStepStats* stats, ImplicitProfile* profile) {
+  Impl& w = *impl_;
+  if (state.status != StepStatus::Ok) return state.status;
+  if (state.x.size() != w.n || state.v.size() != w.n || colliders.size() > w.max_colliders)
+    throw std::invalid_argument("ImplicitSolver::step: state or colliders not made for this solver's model");
+  const double h = s.time_step;
+  Timer timer(profile != nullptr);
+  double scratch_time = 0;
+  for (Collider* c : colliders) c->update(state.time + h);
+  // Start: x0 = x_n; the inertial target y = x_n + h v_n (at rest: x_n); pinned particles follow y.
+  for (size_t i = 0; i < w.n; ++i) {
+    w.x0[i] = state.x[i].cast<double>();
+    w.y[i] = s.quasi_static ? w.x0[i] : Vec3d(w.x0[i] + h * state.v[i].cast<double>());
+    w.x[i] = w.free[i] ? w.x0[i] : w.y[i];
+  }
+  if (!w.analysed) {
+    w.cholesky.analyzePattern(w.matrix);
+    w.analysed = true;
+  }
+  ImplicitStepStats st;
+  w.factored = false;
+  const double max_move = s.max_move;
+  // Contact planes are kept from step to step, and a particle's is found anew only once it moved
+  // kReplane from where it was found (or max_move, out of contact): Newton then converges on fixed
+  // planes (a body's interpolated normals are not the gradient of its distance, so planes found
+  // anew at every iteration differ by a little each time and the iterations chatter). Colliders
+  // that move have every plane found anew at the start of each step.
+  w.detect_contacts(colliders, s, h, !w.planes_valid || s.moving_colliders);
+  w.planes_valid = true;
+  w.lag_friction(s);
+  for (int it = 0; it < kMaxNewtonIterations; ++it) {
+    if (it > 0) w.detect_contacts(colliders, s, h, false);
+    timer.mark(profile ? profile->contacts : scratch_time);
+    w.assemble(s, h);
+    timer.mark(profile ? profile->assemble : scratch_time);
+    if (w.force_ratio <= kNewtonForceTolerance) {
+      st.converged = true;
+      break;
+    }
+    // The Newton direction: conjugate gradients preconditioned by the last factorisation (the
+    // matrix changes little from one iteration to the next), or a fresh factorisation when there is
+    // none yet in this step or they do not reach the tolerance in kMaxPcgIterations.
+    if (!w.factored || !w.preconditioned_solve()) {
+      w.cholesky.factorize(w.matrix);
+      timer.mark(profile ? profile->factorize : scratch_time);
+      if (w.cholesky.info() != Eigen::Success) {
+        state.status = StepStatus::NonFinite;
+        break;
+      }
+      w.factored = true;
+      w.direction = w.cholesky.solve(-w.gradient);
+      if (profile) ++profile->factorizations;
+    }
+    timer.mark(profile ? profile->solve : scratch_time);
+    // Largest move of a particle, capped at max_move.
+    double largest = 0;
+    for (size_t i = 0; i < w.n; ++i)
+      largest = std::max(largest, w.direction.segment<3>(static_cast<Eigen::Index>(3 * i)).squaredNorm());
+    largest = std::sqrt(largest);
+    if (!std::isfinite(largest)) {
+      state.status = StepStatus::NonFinite;
+      break;
+    }
+    double alpha = largest > max_move ? max_move / largest : 1.0;
+    // Backtracking line search on E (Armijo).
+    const double e0 = w.energy(w.x, s, h);
+    const double slope = w.gradient.dot(w.direction);
+    int halvings = 0;
+    for (;; ++halvings) {
+      for (size_t i = 0; i < w.n; ++i)
+        w.trial[i] = w.x[i] + alpha * w.direction.segment<3>(static_cast<Eigen::Index>(3 * i));
+      const double e = w.energy(w.trial, s, h);
+      if (e <= e0 + kArmijo * alpha * slope || halvings >= kMaxHalvings) break;
+      alpha *= 0.5;
+    }
+    std::swap(w.x, w.trial);
+    timer.mark(profile ? profile->line_search : scratch_time);
+    ++st.newton_iterations;
+    if (profile) profile->line_search_halvings += static_cast<uint64_t>(halvings);
+    if (alpha * largest < kStagnation) {
+      st.converged = true;
+      break;
+    }
+  }
+  // The state: positions, and velocities from the step (quasi-static: at rest).
+  float moved2 = 0;
+  double kinetic = 0;
+  float speed2 = 0;
+  bool finite = true;
+  for (size_t i = 0; i < w.n; ++i) {
+    const Vec3f xn = w.x[i].cast<float>();
+    moved2 = std::max(moved2, (xn - state.x[i]).squaredNorm());
+    const Vec3f v = s.quasi_static ? Vec3f::Zero() : Vec3f(((w.x[i] - w.x0[i]) / h).cast<float>());
+    finite = finite && std::isfinite(xn.squaredNorm()) && std::isfinite(v.squaredNorm());
+    state.x[i] = xn;
+    state.v[i] = v;
+    speed2 = std::max(speed2, v.squaredNorm());
+    kinetic += 0.5 * static_cast<double>(w.model.mass[i]) * static_cast<double>(v.squaredNorm());
+  }
+  if (!finite && state.status == StepStatus::Ok) state.status = StepStatus::NonFinite;
+  state.time += h;
+  ++state.iterations;
+  state.max_speed = std::sqrt(speed2);
+  state.kinetic_energy = kinetic;
+  if (stats) {
+    st.residual = w.residual(s);
+    uint32_t contacts = 0;
+    for (size_t i = 0; i < w.n; ++i)
+      contacts += w.in_range[i] && w.plane_normal[i].dot(w.x[i]) + w.plane_offset[i] < w.model.fabric.collision_thickness ? 1u : 0u;
+    st.contacts = contacts;
+    st.max_move = std::sqrt(moved2);
+    *stats = st;
+    timer.mark(profile ? profile->contacts : scratch_time);
+  }
+  if (profile) {
+    ++profile->steps;
+    profile->newton_iterations += static_cast<uint64_t>(st.newton_iterations);
+  }
+  return state.status;
+}
+
+}  // namespace drape

@@ -1,5 +1,5 @@
-// `drape body`: a body from measurements (drape's parametric generator; no data files), written as a
-// rigged GLB/glTF (or OBJ/PLY without the rig). Prints the requested and measured values as JSON.
+// `drape body`: a body from measurements (made on MakeHuman's CC0 body, compiled into drape), written
+// as a rigged GLB/glTF (or OBJ/PLY without the rig). Prints the requested and measured values as JSON.
 #include <cmath>
 
 #include <fmt/format.h>
@@ -18,6 +18,7 @@ struct BodyArgs {
   std::string measurements;
   std::string out = "body.glb";
   float grid = 0.011f;
+  std::string skeleton = "drape";
 };
 
 void run_body(const BodyArgs& args) {
@@ -25,6 +26,7 @@ void run_body(const BodyArgs& args) {
   const MeasurementRequest request = args.measurements.empty() ? MeasurementRequest{} : parse_measurements(args.measurements);
   BodyBuildOptions options;
   options.grid_step = args.grid;
+  options.skeleton = args.skeleton == "cmu_mb" ? BodySkeleton::CmuMb : BodySkeleton::Drape;
   // No measurements: the built-in body, baked into the binary at the default grid, made now at another.
   const Body body = !request.empty()                               ? make_body(sex, request, options)
                     : options.grid_step != BodyBuildOptions{}.grid_step ? generate_default_body(sex, options)
@@ -37,8 +39,8 @@ void run_body(const BodyArgs& args) {
   j["vertices"] = body.mesh.vertex_count();
   j["triangles"] = body.mesh.triangle_count();
   j["joints"] = body.skeleton.joints.size();
-  // Keys the generator could only fit approximately (more than 1 cm off: a combination the body
-  // shape cannot reach, see docs/bodies.md) are flagged in the report and named on stderr.
+  // Keys more than 1 cm off (a combination beyond what a human body, as MakeHuman's targets span it,
+  // can have: docs/bodies.md) are flagged in the report and named on stderr.
   std::string approximate;
   for (const auto& row : measurement_table()) {
     const std::string key(row.key);
@@ -54,23 +56,29 @@ void run_body(const BodyArgs& args) {
     j["measurements"][key] = entry;
   }
   fmt::print("{}\n", j.dump(2));
-  if (!approximate.empty()) fmt::print(stderr, "drape: body: fitted approximately: {}\n", approximate);
+  if (!approximate.empty())
+    fmt::print(stderr, "drape: body: no human body has this combination; fitted approximately: {}\n", approximate);
 }
 
 }  // namespace
 
 void add_body_command(CLI::App& app) {
   auto args = std::make_shared<BodyArgs>();
-  auto* cmd = app.add_subcommand("body", "Make a rigged body from measurements (A-pose, metres)");
+  auto* cmd = app.add_subcommand("body", "Make a rigged body from measurements on MakeHuman's body (A-pose, metres)");
   cmd->add_option("--sex", args->sex, "female or male")->check(CLI::IsMember({"female", "male"}))->default_val("female");
   std::string keys;
   for (const auto& row : measurement_table()) keys += (keys.empty() ? "" : ", ") + std::string(row.key);
   cmd->add_option("--measurements", args->measurements,
                   "Comma-separated key=metres, e.g. height=1.70,bust=0.92,waist=0.74,hips=0.98. Keys: " + keys +
-                      ". Unset keys follow the average adult scaled to the given height and girths; without "
-                      "this option the built-in average body is made.");
+                      ". Unset keys stay as MakeHuman's average body of the fitted build (height: the "
+                      "average adult's); without this option the built-in average body is made.");
   cmd->add_option("-o,--out", args->out, "Output file (.glb, .gltf with the rig; .obj, .ply mesh only)")->default_val("body.glb");
-  cmd->add_option("--grid", args->grid, "Polygonisation step in metres (smaller = more triangles)")
+  cmd->add_option("--skeleton", args->skeleton,
+                  "Rig of a body made from measurements: drape (MakeHuman's default skeleton as drape's CMU-named "
+                  "joints) or cmu_mb (MakeHuman's 31-joint CMU motion-builder skeleton)")
+      ->check(CLI::IsMember({"drape", "cmu_mb"}))
+      ->default_val("drape");
+  cmd->add_option("--grid", args->grid, "The built-in body (no --measurements) made now at this polygonisation step, metres")
       ->check(CLI::Range(0.005f, 0.03f))
       ->default_val(0.011f);
   cmd->callback([args] { run_body(*args); });

@@ -50,19 +50,19 @@ std::vector<std::pair<std::string_view, Vec3f>> Landmarks::named() const {
 
 namespace body {
 
-std::optional<SectionPiece> torso_section(const Mesh& mesh, float y) {
+std::optional<SectionPiece> torso_section(const Slicer& mesh, float y) {
   auto pieces = slice(mesh, horizontal_plane(y));
   const int i = piece_straddling(pieces, 0.0f);
   if (i < 0) return std::nullopt;
   return std::move(pieces[static_cast<size_t>(i)]);
 }
 
-float torso_girth(const Mesh& mesh, float y) {
+float torso_girth(const Slicer& mesh, float y) {
   auto s = torso_section(mesh, y);
   return s ? hull_perimeter(s->points) : 0.0f;
 }
 
-std::optional<SectionPiece> leg_section(const Mesh& mesh, float y, int side) {
+std::optional<SectionPiece> leg_section(const Slicer& mesh, float y, int side) {
   auto pieces = slice(mesh, horizontal_plane(y));
   // The leg is the piece on that side nearest the midline (hands hang further out).
   int best = -1;
@@ -82,7 +82,7 @@ SlicePlane limb_plane(const Vec3f& point, const Vec3f& axis) {
   return SlicePlane{point, n, u.normalized()};
 }
 
-std::optional<SectionPiece> limb_section(const Mesh& mesh, const Vec3f& point, const Vec3f& axis) {
+std::optional<SectionPiece> limb_section(const Slicer& mesh, const Vec3f& point, const Vec3f& axis) {
   const SlicePlane plane = limb_plane(point, axis);
   auto pieces = slice(mesh, plane);
   const int i = nearest_piece(pieces, Vec2f::Zero());
@@ -90,7 +90,7 @@ std::optional<SectionPiece> limb_section(const Mesh& mesh, const Vec3f& point, c
   return std::move(pieces[static_cast<size_t>(i)]);
 }
 
-float limb_girth(const Mesh& mesh, const Vec3f& point, const Vec3f& axis) {
+float limb_girth(const Slicer& mesh, const Vec3f& point, const Vec3f& axis) {
   auto s = limb_section(mesh, point, axis);
   return s ? hull_perimeter(s->points) : 0.0f;
 }
@@ -110,7 +110,7 @@ struct ArmLandmarks {
   Vec3f shoulder, armpit, elbow, wrist, fingertip;
 };
 
-ArmLandmarks find_arm(const Mesh& mesh, int side, float armpit_y, const SectionPiece& below_armpit_torso,
+ArmLandmarks find_arm(const Slicer& mesh, int side, float armpit_y, const SectionPiece& below_armpit_torso,
                       float neck_y, const std::string& source) {
   const float s = static_cast<float>(side);
   ArmLandmarks arm{};
@@ -196,7 +196,8 @@ ArmLandmarks find_arm(const Mesh& mesh, int side, float armpit_y, const SectionP
 
 }  // namespace
 
-Landmarks find_landmarks(const Mesh& mesh, const std::string& source) {
+Landmarks find_landmarks(const Mesh& input, const std::string& source) {
+  const Slicer mesh(input);  // indexed once: the search below slices it thousands of times
   if (mesh.positions.empty() || mesh.triangles.empty()) throw InputError(source, "no mesh");
   Landmarks lm;
   const Bounds box = bounds(mesh.positions);

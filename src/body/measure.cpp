@@ -32,10 +32,10 @@ namespace {
 
 using namespace body;
 
-float torso_girth_at(const Mesh& mesh, float y) { return torso_girth(mesh, y); }
+float torso_girth_at(const Slicer& mesh, float y) { return torso_girth(mesh, y); }
 
 // Length of the back midline profile (the section x = 0, back half) between two heights.
-float back_profile_length(const Mesh& mesh, float from_y, float to_y, float front_of_back_z) {
+float back_profile_length(const Slicer& mesh, float from_y, float to_y, float front_of_back_z) {
   // Plane x = 0 with u = +Y, v = normal x u = (1,0,0) x (0,1,0) = +Z.
   const SlicePlane plane{Vec3f::Zero(), Vec3f::UnitX(), Vec3f::UnitY()};
   std::vector<Vec2f> back;  // (y, z) of the back surface
@@ -60,7 +60,7 @@ float back_profile_length(const Mesh& mesh, float from_y, float to_y, float fron
   return length;
 }
 
-float thigh_girth(const Mesh& mesh, float crotch_y, int side) {
+float thigh_girth(const Slicer& mesh, float crotch_y, int side) {
   // Fullest leg section in the 8 cm below the crotch.
   float best = 0;
   for (float y = crotch_y - 0.003f; y > crotch_y - 0.08f; y -= 0.003f) {
@@ -72,7 +72,8 @@ float thigh_girth(const Mesh& mesh, float crotch_y, int side) {
 
 }  // namespace
 
-Measurements measure_body(const Mesh& mesh, const Landmarks& lm) {
+Measurements measure_body(const Mesh& input, const Landmarks& lm) {
+  const Slicer mesh(input);  // indexed once for the many sections below
   Measurements m;
   m.height = lm.crown.y() - bounds(mesh.positions).min.y();
   m.neck = torso_girth_at(mesh, lm.neck.y());

@@ -14,17 +14,47 @@ SlicePlane horizontal_plane(float height) {
   return SlicePlane{Vec3f(0, height, 0), Vec3f(0, -1, 0), Vec3f(1, 0, 0)};
 }
 
-std::vector<SectionPiece> slice(const Mesh& mesh, const SlicePlane& plane) {
-  const auto& p = mesh.positions;
-  // Body analysis slices the same mesh thousands of times (7489 times for the default body), and
-  // only a few hundred of its triangles cross any one plane: the signs go into a byte per vertex
-  // first, so that the triangles on one side are skipped on three byte loads.
-  std::vector<float> side(p.size());
-  std::vector<uint8_t> below(p.size());
-  for (size_t i = 0; i < p.size(); ++i) {
-    side[i] = (p[i] - plane.origin).dot(plane.normal);
-    below[i] = side[i] < 0 ? 1 : 0;
+Slicer::Slicer(const Mesh& mesh) : positions(mesh.positions), triangles(mesh.triangles) {
+  constexpr float kBand = 0.005f;
+  if (positions.empty()) return;
+  float lo = positions[0].y(), hi = lo;
+  for (const auto& p : positions) {
+    lo = std::min(lo, p.y());
+    hi = std::max(hi, p.y());
   }
+  y0_ = lo;
+  inv_band_ = 1.0f / kBand;
+  const auto bands = static_cast<size_t>((hi - lo) * inv_band_) + 2;
+  auto range = [&](const Tri& t) {
+    const float a = positions[t[0]].y(), b = positions[t[1]].y(), c = positions[t[2]].y();
+    return std::pair<size_t, size_t>(static_cast<size_t>((std::min({a, b, c}) - y0_) * inv_band_),
+                                     static_cast<size_t>((std::max({a, b, c}) - y0_) * inv_band_));
+  };
+  // Counting sort into bands, triangles ascending within each.
+  start_.assign(bands + 1, 0);
+  for (const Tri& t : triangles) {
+    const auto [b0, b1] = range(t);
+    for (size_t b = b0; b <= b1; ++b) ++start_[b + 1];
+  }
+  for (size_t b = 0; b < bands; ++b) start_[b + 1] += start_[b];
+  tris_.resize(start_[bands]);
+  std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
+  for (uint32_t i = 0; i < triangles.size(); ++i) {
+    const auto [b0, b1] = range(triangles[i]);
+    for (size_t b = b0; b <= b1; ++b) tris_[fill[b]++] = i;
+  }
+}
+
+std::span<const uint32_t> Slicer::band(float y) const {
+  const float at = (y - y0_) * inv_band_;
+  if (!(at >= 0) || start_.empty() || at >= static_cast<float>(start_.size() - 1)) return {};
+  const auto b = static_cast<size_t>(at);
+  return std::span<const uint32_t>(tris_).subspan(start_[b], start_[b + 1] - start_[b]);
+}
+
+std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
+  const auto& p = mesh.positions;
+  auto side = [&](uint32_t v) { return (p[v] - plane.origin).dot(plane.normal); };
 
   // Each crossing edge gives one point, keyed by the edge so that neighbouring triangles share it.
   std::unordered_map<uint64_t, uint32_t> point_of_edge;
@@ -36,22 +66,34 @@ std::vector<SectionPiece> slice(const Mesh& mesh, const SlicePlane& plane) {
     const uint64_t key = (uint64_t{a} << 32) | b;
     auto [it, fresh] = point_of_edge.try_emplace(key, static_cast<uint32_t>(points.size()));
     if (fresh) {
-      const float t = side[a] / (side[a] - side[b]);
+      const float sa = side(a), sb = side(b);
+      const float t = sa / (sa - sb);
       const Vec3f q = p[a] + t * (p[b] - p[a]) - plane.origin;
       points.emplace_back(q.dot(plane.u_axis), q.dot(v_axis));
     }
     return it->second;
   };
-  for (const Tri& t : mesh.triangles) {
-    const unsigned signs = below[t[0]] | (below[t[1]] << 1) | (below[t[2]] << 2);
-    if (signs == 0 || signs == 7) continue;  // all on one side
+  auto cut = [&](const Tri& t) {
+    const bool b0 = side(t[0]) < 0, b1 = side(t[1]) < 0, b2 = side(t[2]) < 0;
+    if (b0 == b1 && b1 == b2) return;  // all on one side
+    const bool below[3] = {b0, b1, b2};
     uint32_t ends[2];
     int n = 0;
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = t[e], b = t[(e + 1) % 3];
-      if ((side[a] < 0) != (side[b] < 0) && n < 2) ends[n++] = crossing(a, b);
-    }
+    for (int e = 0; e < 3; ++e)
+      if (below[e] != below[(e + 1) % 3] && n < 2) ends[n++] = crossing(t[e], t[(e + 1) % 3]);
     if (n == 2) links.emplace_back(ends[0], ends[1]);
+  };
+  const bool horizontal = plane.normal.x() == 0 && plane.normal.z() == 0 && std::abs(plane.normal.y()) == 1;
+  if (horizontal) {
+    for (uint32_t i : mesh.band(plane.origin.y())) cut(mesh.triangles[i]);
+  } else {
+    // Every triangle; signs first so that the triangles on one side cost three byte loads.
+    std::vector<uint8_t> below(p.size());
+    for (uint32_t i = 0; i < p.size(); ++i) below[i] = side(i) < 0 ? 1 : 0;
+    for (const Tri& t : mesh.triangles) {
+      const unsigned signs = below[t[0]] | (below[t[1]] << 1) | (below[t[2]] << 2);
+      if (signs != 0 && signs != 7) cut(t);
+    }
   }
 
   // Connected pieces through the segments.

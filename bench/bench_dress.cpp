@@ -54,7 +54,7 @@ double edge_for(const Garment& g, size_t vertices) {
 // fine one from it (DressOptions::coarse_edge); the plain rows start every garment from its placement.
 struct RowRun {
   int scale = 1;
-  bool fine_body = false, directional = false, coarse = false, projected = false;
+  bool fine_body = false, directional = false, coarse = false, projected = false, implicit = false;
 };
 
 void BM_Table2(benchmark::State& state, const PaperRow& row, RowRun run) {
@@ -62,6 +62,7 @@ void BM_Table2(benchmark::State& state, const PaperRow& row, RowRun run) {
   const GarmentSpec spec = *builtin_garment(row.garment);
   const Garment g = garment_in_size(spec, {});
   DressOptions o;
+  o.solver = run.implicit ? Solver::Implicit : Solver::Explicit;
   o.directional_time_step = run.directional;
   o.projection_iterations = run.projected ? 8 : 0;
   o.coarse_edge = run.coarse ? kPaperEdgeLength : 0.0;
@@ -88,6 +89,8 @@ void BM_Table2(benchmark::State& state, const PaperRow& row, RowRun run) {
   state.counters["inside_pct"] = 100 * r.quality.penetration_fraction;
   state.counters["settled"] = r.quality.settled ? 1 : 0;
   state.counters["gates_ok"] = r.passed() ? 1 : 0;
+  state.counters["residual"] = r.quality.residual;
+  state.counters["newton_iter"] = static_cast<double>(d.implicit_profile.newton_iterations);
   state.counters["paper_verts"] = static_cast<double>(row.vertices);
   state.counters["paper_iter"] = row.iterations;
   state.counters["paper_total_s"] = row.total_s;
@@ -101,6 +104,11 @@ int register_table2() {
   };
   for (const PaperRow& row : kTable2)
     for (int scale : {1, 4, 16}) add(std::string(row.garment) + "/x" + std::to_string(scale), row, {.scale = scale});
+  // The implicit solver (drape/implicit.hpp) beside the explicit rows above: x1 and x4 (its x16 rows
+  // take minutes each while its factorisation dominates; docs/cloth.md).
+  for (const PaperRow& row : kTable2)
+    for (int scale : {1, 4})
+      add(std::string(row.garment) + "/x" + std::to_string(scale) + "/implicit", row, {.scale = scale, .implicit = true});
   // Coarse-to-fine: the finer rows started from the garment dressed at the paper's spacing. The
   // skirt and shirt only: the trousers and dress at 16x fail from it (docs/dressing.md,
   // "Coarse-to-fine") after 5 s of draping, which would add ~15 minutes to `make bench`.

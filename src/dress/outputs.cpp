@@ -76,6 +76,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"settled", g.settled},
                         {"residual", g.residual},
                         {"newton_iterations", g.implicit_profile.newton_iterations},
+                        {"factorizations", g.implicit_profile.factorizations},
                         {"initial_max_seam_gap_m", g.initial_max_gap},
                         {"max_seam_gap_m", gaps.max},
                         {"mean_seam_gap_m", gaps.mean},
@@ -107,7 +108,12 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"centre_height_m", {{"placed", g.placed_centre_y}, {"sewn", g.sewn_centre_y}, {"final", g.final_centre_y}}},
                         {"strain_threshold", g.model.fabric.strain_threshold},
                         {"panels", panels},
-                        {"stage_seconds", stages}});
+                        {"stage_seconds", stages},
+                        {"implicit_stage_seconds", {{"contacts", g.implicit_profile.contacts},
+                                                    {"assemble", g.implicit_profile.assemble},
+                                                    {"factorize", g.implicit_profile.factorize},
+                                                    {"solve", g.implicit_profile.solve},
+                                                    {"line_search", g.implicit_profile.line_search}}}});
   }
   extra["garments"] = garments;
   extra["body"] = {{"vertices", body.mesh.vertex_count()},

@@ -138,7 +138,16 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
       v.components *
       static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType)));
   v.stride = element;
-  if (a.bufferView < 0) return v;  // zeros, per the spec
+  if (a.bufferView < 0) {
+    // Zeros, per the spec; never more of them than the file's buffers hold bytes, so a few bytes of
+    // JSON cannot ask for gigabytes.
+    size_t held = 0;
+    for (const tinygltf::Buffer& b : model_.buffers) held += b.data.size();
+    if (a.count > held / element)
+      fail(fmt::format("{}: {} elements without a buffer view, more than the file's {} bytes of buffers hold",
+                       where, a.count, held));
+    return v;
+  }
   if (static_cast<size_t>(a.bufferView) >= model_.bufferViews.size())
     fail(fmt::format("{}: buffer view {} does not exist", where, a.bufferView));
   const tinygltf::BufferView& bv = model_.bufferViews[static_cast<size_t>(a.bufferView)];

@@ -41,12 +41,13 @@ sanitize: deps
 	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 DRAPE_SANITIZED=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
-# libFuzzer targets, one per parser (clang-14), in build-fuzz/.
+# libFuzzer targets, one per parser a user's file reaches (clang-14), in build-fuzz/.
+# fuzz/run.sh fuzzes one of them from its kept corpus and merges what it finds (docs/robustness.md).
 fuzz: deps
 	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_FUZZ=ON \
 	  -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14
 	cmake --build build-fuzz -j $(JOBS)
-	@echo "fuzz targets: build-fuzz/fuzz_*  (run e.g. build-fuzz/fuzz_obj -max_total_time=60 tests/corpus/info)"
+	@echo "fuzz targets: build-fuzz/fuzz_{obj,ply,gltf,garment_json,garmentcode,dxf}  (run e.g. fuzz/run.sh obj 1000000 600 tests/corpus/info)"
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "body/slicing.hpp"
+#include "drape/body.hpp"
 #include "drape/mesh.hpp"
 
 namespace drape::body {
@@ -16,5 +17,14 @@ std::optional<SectionPiece> leg_section(const Slicer& mesh, float y, int side);
 SlicePlane limb_plane(const Vec3f& point, const Vec3f& axis);
 std::optional<SectionPiece> limb_section(const Slicer& mesh, const Vec3f& point, const Vec3f& axis);
 float limb_girth(const Slicer& mesh, const Vec3f& point, const Vec3f& axis);
+
+// The underbust of a body whose bust points are known (`height`: its crown's height): sets
+// lm.underbust; false when there is no torso below the bust.
+bool find_underbust(const Slicer& mesh, Landmarks& lm, float height);
+// The waist (narrowest torso section from 30 % to 70 % of the way crotch -> lower armpit) and the
+// hip (fullest torso section between the crotch and the waist), found on a body whose crotch and
+// armpits are known: sets lm.waist and lm.hip.
+enum class WaistAndHip { kFound, kNoWaist, kNoHips };
+WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm);
 
 }  // namespace drape::body

@@ -95,6 +95,72 @@ float limb_girth(const Slicer& mesh, const Vec3f& point, const Vec3f& axis) {
   return s ? hull_perimeter(s->points) : 0.0f;
 }
 
+bool find_underbust(const Slicer& mesh, Landmarks& lm, float height) {
+  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+  // Underbust: going down from the bust, the first dip of the front profile (the fold under the
+  // breasts, or where the front stops receding), then 1 cm lower to clear the breast tissue. A flat
+  // chest (the front recedes by less than 5 mm before the dip) has no fold to find: its underbust
+  // is 4 % of the height under the bust points, where the pectorals end.
+  {
+    float min_front = 1e9f, min_y = -1.0f, top_front = -1e9f;
+    for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      top_front = std::max(top_front, s->max.y());
+      if (s->max.y() < min_front) {
+        min_front = s->max.y();
+        min_y = y;
+      } else if (s->max.y() > min_front + 0.002f) {
+        break;
+      }
+    }
+    if (min_y < 0) return false;
+    if (top_front - min_front < 0.005f) {
+      min_y = bust_y - 0.04f * height + 0.01f;
+      if (auto s = torso_section(mesh, min_y - 0.01f)) min_front = s->max.y();
+    }
+    lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
+  }
+  return true;
+}
+
+WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm) {
+  const float crotch_y = lm.crotch.y();
+  const float low_armpit = std::min(lm.left_armpit.y(), lm.right_armpit.y());
+  // Waist: the narrowest torso section from 30 % to 70 % of the way crotch -> armpit (independent of
+  // the bust and underbust landmarks, which a man's chest or a belly can move).
+  {
+    float best = 1e9f;
+    const float from = crotch_y + 0.3f * (low_armpit - crotch_y);
+    for (float y = from; y < crotch_y + 0.7f * (low_armpit - crotch_y); y += 0.003f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      const float g = hull_perimeter(s->points);
+      if (g < best) {
+        best = g;
+        lm.waist = Vec3f(0.0f, y, s->max.y());
+      }
+    }
+    if (best > 1e8f) return WaistAndHip::kNoWaist;
+  }
+  // Hip: the fullest torso section between the crotch and the waist.
+  {
+    float best = 0;
+    for (float y = crotch_y + 0.015f; y < lm.waist.y(); y += 0.003f) {
+      auto s = torso_section(mesh, y);
+      if (!s) continue;
+      const float g = hull_perimeter(s->points);
+      if (g > best) {
+        best = g;
+        lm.hip = Vec3f(0.0f, y, s->min.y());
+      }
+    }
+    if (best <= 0) return WaistAndHip::kNoHips;
+  }
+
+  return WaistAndHip::kFound;
+}
+
 }  // namespace body
 
 namespace {
@@ -308,62 +374,12 @@ Landmarks find_landmarks(const Mesh& input, const std::string& source) {
     if (best.z() < -1e8f) fail(source, "cannot find the chest");
     (side > 0 ? lm.left_bust : lm.right_bust) = best;
   }
-  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+  if (!find_underbust(mesh, lm, height)) fail(source, "no torso below the bust");
 
-  // Underbust: going down from the bust, the first dip of the front profile (the fold under the
-  // breasts, or where the front stops receding), then 1 cm lower to clear the breast tissue. A flat
-  // chest (the front recedes by less than 5 mm before the dip) has no fold to find: its underbust
-  // is 4 % of the height under the bust points, where the pectorals end.
-  {
-    float min_front = 1e9f, min_y = -1.0f, top_front = -1e9f;
-    for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f) {
-      auto s = torso_section(mesh, y);
-      if (!s) continue;
-      top_front = std::max(top_front, s->max.y());
-      if (s->max.y() < min_front) {
-        min_front = s->max.y();
-        min_y = y;
-      } else if (s->max.y() > min_front + 0.002f) {
-        break;
-      }
-    }
-    if (min_y < 0) fail(source, "no torso below the bust");
-    if (top_front - min_front < 0.005f) {
-      min_y = bust_y - 0.04f * height + 0.01f;
-      if (auto s = torso_section(mesh, min_y - 0.01f)) min_front = s->max.y();
-    }
-    lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
-  }
-
-  // Waist: the narrowest torso section from 30 % to 70 % of the way crotch -> armpit (independent of
-  // the bust and underbust landmarks, which a man's chest or a belly can move).
-  {
-    float best = 1e9f;
-    const float from = crotch_y + 0.3f * (low_armpit - crotch_y);
-    for (float y = from; y < crotch_y + 0.7f * (low_armpit - crotch_y); y += 0.003f) {
-      auto s = torso_section(mesh, y);
-      if (!s) continue;
-      const float g = hull_perimeter(s->points);
-      if (g < best) {
-        best = g;
-        lm.waist = Vec3f(0.0f, y, s->max.y());
-      }
-    }
-    if (best > 1e8f) fail(source, "cannot find the waist");
-  }
-  // Hip: the fullest torso section between the crotch and the waist.
-  {
-    float best = 0;
-    for (float y = crotch_y + 0.015f; y < lm.waist.y(); y += 0.003f) {
-      auto s = torso_section(mesh, y);
-      if (!s) continue;
-      const float g = hull_perimeter(s->points);
-      if (g > best) {
-        best = g;
-        lm.hip = Vec3f(0.0f, y, s->min.y());
-      }
-    }
-    if (best <= 0) fail(source, "cannot find the hips");
+  switch (find_waist_and_hip(mesh, lm)) {
+    case WaistAndHip::kFound: break;
+    case WaistAndHip::kNoWaist: fail(source, "cannot find the waist");
+    case WaistAndHip::kNoHips: fail(source, "cannot find the hips");
   }
 
   // Ankles: the narrowest leg section between 3 % and 12 % of the height; knees at 57 % of the way

@@ -22,6 +22,7 @@
 
 #include <Eigen/Dense>
 
+#include "body/analysis.hpp"
 #include "body/makehuman.hpp"
 #include "drape/body.hpp"
 #include "drape/error.hpp"
@@ -59,7 +60,7 @@ struct Unknown {
 // Every unknown, in a fixed order: weight, height, scale, then the measurement targets. Targets
 // may go to twice MakeHuman's range (the largest and smallest sizes need it).
 Unknown unknown(int i) {
-  if (i == 0) return {Unknown::kWeight, 0, 0.0f, 2.0f, 0.5f, 0.05f, 0.05f};
+  if (i == 0) return {Unknown::kWeight, 0, 0.0f, 2.5f, 0.5f, 0.05f, 0.05f};
   if (i == 1) return {Unknown::kHeight, 0, 0.0f, 1.0f, 0.5f, 0.05f, 0.05f};
   if (i == 2) return {Unknown::kScale, 0, 0.8f, 1.25f, 1.0f, 200.0f, 0.01f};
   return {Unknown::kMeasure, i - 3, -2.5f, 2.5f, 0.0f, 0.1f, 0.1f};
@@ -257,9 +258,18 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
     if (miss < kTolerance) break;
     // Solve with the landmarks pinned where they are now.
     const Pins pins = pin(mesh, *lm);
+    // The underbust, the waist and the hip are searched again (their searches are cheap): the
+    // waist is the narrowest level and the hip the fullest, so widening a pinned waist could leave
+    // a narrower level elsewhere, and a flat chest's underbust flips between its two rules.
     auto pinned = [&](const Eigen::VectorXd& v) {
       const Mesh& m = shaper(shape_at(v));
-      return residuals(measure_body(m, place(pins, m)), keys);
+      Landmarks at = place(pins, m);
+      Landmarks searched = at;
+      const body::Slicer slicer(m);
+      if (body::find_underbust(slicer, searched, at.crown.y()) &&
+          body::find_waist_and_hip(slicer, searched) == body::WaistAndHip::kFound)
+        at = searched;
+      return residuals(measure_body(m, at), keys);
     };
     auto fresh_jacobian = [&]() {
       jac.resize(k, n);
@@ -299,11 +309,11 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
         r = ry;
         f = fy;
         mu = std::max(mu / 3, 1e-6);
-      } else if ((mu *= 4) > 1e2) {
-        if (fresh) break;
-        fresh_jacobian();
+      } else if (!fresh) {
+        fresh_jacobian();  // the updated Jacobian misled: measure a true one
         fresh = true;
-        mu = 1e-3;
+      } else if ((mu *= 4) > 1e3) {
+        break;
       }
     }
   }

@@ -2,6 +2,7 @@
 #include "geometry/disjoint_sets.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cmath>
 #include <numeric>
@@ -25,23 +26,25 @@ Slicer::Slicer(const Mesh& mesh) : positions(mesh.positions), triangles(mesh.tri
   y0_ = lo;
   inv_band_ = 1.0f / kBand;
   const auto bands = static_cast<size_t>((hi - lo) * inv_band_) + 2;
+  // A triangle's bands run from its lowest vertex's band to its highest's.
+  std::vector<uint32_t> vertex_band(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) vertex_band[i] = static_cast<uint32_t>((positions[i].y() - y0_) * inv_band_);
   auto range = [&](const Tri& t) {
-    const float a = positions[t[0]].y(), b = positions[t[1]].y(), c = positions[t[2]].y();
-    return std::pair<size_t, size_t>(static_cast<size_t>((std::min({a, b, c}) - y0_) * inv_band_),
-                                     static_cast<size_t>((std::max({a, b, c}) - y0_) * inv_band_));
+    const uint32_t a = vertex_band[t[0]], b = vertex_band[t[1]], c = vertex_band[t[2]];
+    return std::pair<uint32_t, uint32_t>(std::min({a, b, c}), std::max({a, b, c}));
   };
   // Counting sort into bands, triangles ascending within each.
   start_.assign(bands + 1, 0);
   for (const Tri& t : triangles) {
     const auto [b0, b1] = range(t);
-    for (size_t b = b0; b <= b1; ++b) ++start_[b + 1];
+    for (uint32_t b = b0; b <= b1; ++b) ++start_[b + 1];
   }
   for (size_t b = 0; b < bands; ++b) start_[b + 1] += start_[b];
   tris_.resize(start_[bands]);
   std::vector<uint32_t> fill(start_.begin(), start_.end() - 1);
   for (uint32_t i = 0; i < triangles.size(); ++i) {
     const auto [b0, b1] = range(triangles[i]);
-    for (size_t b = b0; b <= b1; ++b) tris_[fill[b]++] = i;
+    for (uint32_t b = b0; b <= b1; ++b) tris_[fill[b]++] = i;
   }
 }
 
@@ -56,32 +59,22 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
   const auto& p = mesh.positions;
   auto side = [&](uint32_t v) { return (p[v] - plane.origin).dot(plane.normal); };
 
-  // Each crossing edge gives one point, keyed by the edge so that neighbouring triangles share it.
-  std::unordered_map<uint64_t, uint32_t> point_of_edge;
-  std::vector<Vec2f> points;
-  std::vector<std::pair<uint32_t, uint32_t>> links;
-  const Vec3f v_axis = plane.v_axis();
-  auto crossing = [&](uint32_t a, uint32_t b) -> uint32_t {
-    if (a > b) std::swap(a, b);
-    const uint64_t key = (uint64_t{a} << 32) | b;
-    auto [it, fresh] = point_of_edge.try_emplace(key, static_cast<uint32_t>(points.size()));
-    if (fresh) {
-      const float sa = side(a), sb = side(b);
-      const float t = sa / (sa - sb);
-      const Vec3f q = p[a] + t * (p[b] - p[a]) - plane.origin;
-      points.emplace_back(q.dot(plane.u_axis), q.dot(v_axis));
-    }
-    return it->second;
-  };
+  // Each crossing edge gives one point, shared by the two triangles on it. Edges are collected in
+  // the order met (two per cut triangle), then sorted by key to find each edge's first meeting:
+  // points are numbered in that order, as a hash map keyed by edge would number them.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;  // (edge key, order met)
+  std::vector<std::array<uint32_t, 2>> edge_ends;    // per order met: the edge's vertices
   auto cut = [&](const Tri& t) {
     const bool b0 = side(t[0]) < 0, b1 = side(t[1]) < 0, b2 = side(t[2]) < 0;
     if (b0 == b1 && b1 == b2) return;  // all on one side
     const bool below[3] = {b0, b1, b2};
-    uint32_t ends[2];
-    int n = 0;
     for (int e = 0; e < 3; ++e)
-      if (below[e] != below[(e + 1) % 3] && n < 2) ends[n++] = crossing(t[e], t[(e + 1) % 3]);
-    if (n == 2) links.emplace_back(ends[0], ends[1]);
+      if (below[e] != below[(e + 1) % 3]) {
+        uint32_t a = t[e], c = t[(e + 1) % 3];
+        if (a > c) std::swap(a, c);
+        edges.emplace_back((uint64_t{a} << 32) | c, static_cast<uint32_t>(edges.size()));
+        edge_ends.push_back({a, c});
+      }
   };
   const bool horizontal = plane.normal.x() == 0 && plane.normal.z() == 0 && std::abs(plane.normal.y()) == 1;
   if (horizontal) {
@@ -95,6 +88,34 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
       if (signs != 0 && signs != 7) cut(t);
     }
   }
+  // First meeting of each edge, and the points numbered by first meeting.
+  const size_t met = edges.size();
+  std::vector<std::pair<uint64_t, uint32_t>> sorted = edges;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<uint32_t> first(met);  // per order met: the order its edge was first met
+  for (size_t i = 0; i < met;) {
+    size_t j = i;
+    while (j < met && sorted[j].first == sorted[i].first) first[sorted[j++].second] = sorted[i].second;
+    i = j;
+  }
+  std::vector<uint32_t> point_of(met, 0);
+  std::vector<Vec2f> points;
+  const Vec3f v_axis = plane.v_axis();
+  for (uint32_t i = 0; i < met; ++i) {
+    if (first[i] != i) {
+      point_of[i] = point_of[first[i]];
+      continue;
+    }
+    point_of[i] = static_cast<uint32_t>(points.size());
+    const uint32_t a = edge_ends[i][0], b = edge_ends[i][1];
+    const float sa = side(a), sb = side(b);
+    const float t = sa / (sa - sb);
+    const Vec3f q = p[a] + t * (p[b] - p[a]) - plane.origin;
+    points.emplace_back(q.dot(plane.u_axis), q.dot(v_axis));
+  }
+  // A cut triangle met its two crossing edges one after the other.
+  std::vector<std::pair<uint32_t, uint32_t>> links;
+  for (uint32_t i = 0; i + 1 < met; i += 2) links.emplace_back(point_of[i], point_of[i + 1]);
 
   // Connected pieces through the segments.
   DisjointSets sets(points.size());

@@ -305,6 +305,9 @@ TEST(MadeBody, AllKeysAtOnce) {
       {Sex::Female,
        "height=1.70,neck=0.34,bust=0.94,underbust=0.80,waist=0.76,hips=1.00,thigh=0.58,upper_arm=0.29,"
        "wrist=0.16,inseam=0.77,arm_length=0.57,shoulder_width=0.37,back_length=0.41"},
+      {Sex::Male,
+       "height=1.80,neck=0.40,bust=1.02,underbust=0.92,waist=0.88,hips=1.00,thigh=0.58,upper_arm=0.32,"
+       "wrist=0.18,inseam=0.83,arm_length=0.61,shoulder_width=0.42,back_length=0.46"},
       {Sex::Male, ""}};
   for (const auto& [sex, text] : requests) {
     MeasurementRequest request = *text ? parse_measurements(text) : MeasurementRequest{};

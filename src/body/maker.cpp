@@ -34,7 +34,7 @@ using body::MhModel;
 using body::MhShape;
 
 constexpr float kCm = 0.01f;
-constexpr double kTolerance = 0.3;  // cm: done when every requested key is this close
+constexpr double kTolerance = 0.5;  // cm: done when every requested key is this close
 constexpr double kMaxMove = 0.4;    // the largest change of one unknown in one step
 constexpr int kRounds = 8;          // landmark searches at most
 constexpr int kSteps = 12;          // solver steps per round at most
@@ -285,7 +285,7 @@ Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions&
     double f = objective(r, x);
     double mu = 1e-3;
     bool fresh = round == 0;
-    for (int step_count = 0; step_count < kSteps && r.cwiseAbs().maxCoeff() > 0.1 * kTolerance; ++step_count) {
+    for (int step_count = 0; step_count < kSteps && r.cwiseAbs().maxCoeff() > 0.2 * kTolerance; ++step_count) {
       const Eigen::MatrixXd jtj = jac.transpose() * jac;
       Eigen::MatrixXd a = jtj;
       a.diagonal() += cost + mu * (jtj.diagonal().array() + 1e-3).matrix();

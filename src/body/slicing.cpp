@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 namespace drape::body {
 
@@ -64,6 +63,8 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
   // points are numbered in that order, as a hash map keyed by edge would number them.
   std::vector<std::pair<uint64_t, uint32_t>> edges;  // (edge key, order met)
   std::vector<std::array<uint32_t, 2>> edge_ends;    // per order met: the edge's vertices
+  edges.reserve(512);
+  edge_ends.reserve(512);
   auto cut = [&](const Tri& t) {
     const bool b0 = side(t[0]) < 0, b1 = side(t[1]) < 0, b2 = side(t[2]) < 0;
     if (b0 == b1 && b1 == b2) return;  // all on one side
@@ -120,12 +121,15 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
   // Connected pieces through the segments.
   DisjointSets sets(points.size());
   for (auto [a, b] : links) sets.unite(a, b);
-  std::unordered_map<uint32_t, size_t> piece_of_root;
+  std::vector<int32_t> piece_of_root(points.size(), -1);
   std::vector<SectionPiece> pieces;
   for (uint32_t i = 0; i < points.size(); ++i) {
-    auto [it, fresh] = piece_of_root.try_emplace(sets.find(i), pieces.size());
-    if (fresh) pieces.emplace_back();
-    pieces[it->second].points.push_back(points[i]);
+    int32_t& piece = piece_of_root[sets.find(i)];
+    if (piece < 0) {
+      piece = static_cast<int32_t>(pieces.size());
+      pieces.emplace_back();
+    }
+    pieces[static_cast<size_t>(piece)].points.push_back(points[i]);
   }
   std::erase_if(pieces, [](const SectionPiece& s) { return s.points.size() < 3; });
   for (auto& s : pieces) {

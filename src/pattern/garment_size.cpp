@@ -100,8 +100,32 @@ bool segments_intersect(const Vec2d& p0, const Vec2d& p1, const Vec2d& q0, const
   return on_segment(p0, p1, q0) || on_segment(p0, p1, q1) || on_segment(q0, q1, p0) || on_segment(q0, q1, p1);
 }
 
+// A garment panel measures at most this across; larger is a units mistake, and would be sampled
+// and meshed into billions of points.
+constexpr double kMaxPanelExtent = 10.0;  // metres
+
+// The outline's extent from the points that bound it (Bezier curves lie in their control hull).
+double outline_extent(const Panel& panel) {
+  Eigen::AlignedBox2d box;
+  for (const Curve& c : panel.edges) {
+    box.extend(c.start);
+    box.extend(c.end);
+    if (c.kind == EdgeCurve::quadratic || c.kind == EdgeCurve::cubic)
+      for (const Vec2d& p : c.control) box.extend(p);
+    for (const Vec2d& p : c.points) box.extend(p);
+    if (c.kind == EdgeCurve::arc) {
+      box.extend(c.centre - Vec2d::Constant(c.radius));
+      box.extend(c.centre + Vec2d::Constant(c.radius));
+    }
+  }
+  return box.isEmpty() ? 0.0 : box.sizes().maxCoeff();
+}
+
 void check_outline(const Panel& panel, const std::string& source) {
   const std::string where = fmt::format("panel '{}'", panel.name);
+  if (const double extent = outline_extent(panel); !(extent <= kMaxPanelExtent))
+    throw InputError(source, fmt::format("{}: measures {:.3g} m across; a garment panel measures at most {} m "
+                                         "(are the units right?)", where, extent, kMaxPanelExtent));
   for (size_t k = 0; k < panel.edges.size(); ++k)
     if (panel.edges[k].length() < 1e-6)
       throw InputError(source, fmt::format("{} edge {}: has zero length", where, k));

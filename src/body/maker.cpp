@@ -60,7 +60,7 @@ struct Unknown {
 // Every unknown, in a fixed order: weight, height, scale, then the measurement targets. Targets
 // may go to twice MakeHuman's range (the largest and smallest sizes need it).
 Unknown unknown(int i) {
-  if (i == 0) return {Unknown::kWeight, 0, 0.0f, 2.5f, 0.5f, 0.05f, 0.05f};
+  if (i == 0) return {Unknown::kWeight, 0, 0.0f, 1.5f, 0.5f, 0.05f, 0.05f};
   if (i == 1) return {Unknown::kHeight, 0, 0.0f, 1.0f, 0.5f, 0.05f, 0.05f};
   if (i == 2) return {Unknown::kScale, 0, 0.8f, 1.25f, 1.0f, 200.0f, 0.01f};
   return {Unknown::kMeasure, i - 3, -2.5f, 2.5f, 0.0f, 0.1f, 0.1f};

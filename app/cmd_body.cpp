@@ -28,7 +28,7 @@ void run_body(const BodyArgs& args) {
   options.grid_step = args.grid;
   options.skeleton = args.skeleton == "cmu_mb" ? BodySkeleton::CmuMb : BodySkeleton::Drape;
   // No measurements: the built-in body, baked into the binary at the default grid, made now at another.
-  const Body body = !request.empty()                               ? make_body(sex, request, options)
+  const Body body = !request.empty()                               ? make_human_body(sex, request, options)
                     : options.grid_step != BodyBuildOptions{}.grid_step ? generate_default_body(sex, options)
                                                                    : default_body(sex);
   write_scene(args.out, body_scene(body));

@@ -24,7 +24,7 @@ void BM_MakeBodyFromMeasurements(benchmark::State& state) {
   const Request& r = requests[state.range(0)];
   const drape::MeasurementRequest request = drape::parse_measurements(r.text);
   drape::body::makehuman_model();  // the pack is decoded once per process, not per body
-  for (auto _ : state) benchmark::DoNotOptimize(drape::make_body(r.sex, request));
+  for (auto _ : state) benchmark::DoNotOptimize(drape::make_human_body(r.sex, request));
 }
 BENCHMARK(BM_MakeBodyFromMeasurements)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 
@@ -34,7 +34,7 @@ void BM_MakeBodyAllKeys(benchmark::State& state) {
       "height=1.70,neck=0.34,bust=0.94,underbust=0.80,waist=0.76,hips=1.00,thigh=0.58,upper_arm=0.29,"
       "wrist=0.16,inseam=0.77,arm_length=0.57,shoulder_width=0.37,back_length=0.41");
   drape::body::makehuman_model();
-  for (auto _ : state) benchmark::DoNotOptimize(drape::make_body(drape::Sex::Female, request));
+  for (auto _ : state) benchmark::DoNotOptimize(drape::make_human_body(drape::Sex::Female, request));
 }
 BENCHMARK(BM_MakeBodyAllKeys)->Unit(benchmark::kMillisecond);
 

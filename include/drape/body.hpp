@@ -120,26 +120,34 @@ using MeasurementRequest = std::map<std::string, float, std::less<>>;
 // a malformed number or a value outside what a person can measure.
 MeasurementRequest parse_measurements(std::string_view text);
 
-// Which skeleton make_body rigs its body with: MakeHuman's default skeleton reduced to drape's
+// Which skeleton make_human_body rigs its body with: MakeHuman's default skeleton reduced to drape's
 // CMU-named joints (Hips, Spine, Spine1, Neck, Head, Left/Right Shoulder, Arm, ForeArm, Hand, UpLeg,
 // Leg, Foot, ToeBase: the joints rig_body places), or MakeHuman's cmu_mb skeleton (31 joints, CMU
 // motion-builder names: LHipJoint, LowerBack, Neck1, LeftFingerBase, LThumb, ...). docs/bodies.md.
 enum class BodySkeleton { Drape, CmuMb };
 
-// Builds a watertight, rigged body on MakeHuman's CC0 base mesh (A-pose, 13,380 vertices) whose
-// measurements, taken back off the mesh by measure_body, match every requested key within 1 cm:
-// the weight and height macros and one MakeHuman measurement target per key are solved for.
-// Height is always fitted (the average adult's when not given); keys not given stay as MakeHuman's
-// average body of that build has them. InputError("measurements") for a combination no human body
-// has (underbust above bust, waist and hips far apart, an inseam outside 36-56 % of the height, a
-// wrist not smaller than the upper arm, thighs larger than the hips). A combination beyond the
-// targets' range is built as close as it gets: compare body.measurements with the request
-// (`drape body` names such keys and marks them "within_1cm": false).
 struct BodyBuildOptions {
-  float grid_step = 0.011f;  // generate_default_body: polygonisation step (metres), ~30k triangles
-  int max_fit_iterations = 8;  // generate_default_body: fitting rounds
-  BodySkeleton skeleton = BodySkeleton::Drape;  // make_body: the rig
+  float grid_step = 0.011f;  // make_body (the generator): polygonisation step (metres), ~30k triangles
+  int max_fit_iterations = 8;  // make_body: fitting rounds
+  BodySkeleton skeleton = BodySkeleton::Drape;  // make_human_body: the rig
 };
+
+// A body that looks like a person, made on MakeHuman's CC0 base mesh (A-pose, 13,380 vertices,
+// watertight, no self-intersections), whose measurements, taken back off the mesh by measure_body,
+// match every requested key within 1 cm: the weight and height macros and one MakeHuman measurement
+// target per key are solved for. Height is always fitted (the average adult's when not given);
+// keys not given stay as MakeHuman's average body of that build has them. Rigged from MakeHuman's
+// skeleton (options.skeleton) and skinned with its weights. InputError("measurements") for a
+// combination no human body has (underbust above bust, waist and hips far apart, an inseam outside
+// 36-56 % of the height, a wrist not smaller than the upper arm, thighs larger than the hips). A
+// combination beyond the targets' range is built as close as it gets: compare body.measurements
+// with the request (`drape body` names such keys and marks them "within_1cm": false).
+Body make_human_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options = {});
+
+// drape's parametric generator (implicit sweeps around a skeleton, polygonised; docs/bodies.md):
+// a smooth, watertight, rigged mannequin whose measurements match the request within 1 cm where the
+// shape can reach it (what the default bodies, and the dressing tests' bodies, are made with).
+// InputError("--measurements") when the request is not self-consistent enough to build.
 Body make_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options = {});
 
 // The built-in average adult female (1.65 m) and male (1.78 m). Their meshes are made by
@@ -150,9 +158,6 @@ Body default_body(Sex sex);
 // runs; bit for bit the body default_body returns when built with the same compiler and flags).
 // Other options (a finer grid) give the default body at another resolution.
 Body generate_default_body(Sex sex, const BodyBuildOptions& options = {});
-// drape's parametric generator (implicit sweeps around a skeleton, polygonised; docs/bodies.md) fitted
-// to a request: what the default bodies are made with.
-Body generate_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options = {});
 // The generator's last step, on the mesh it settled on (or that mesh baked): named, analysed, rigged.
 Body finish_generated_body(Sex sex, Mesh mesh);
 MeasurementRequest default_measurements(Sex sex);

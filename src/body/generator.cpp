@@ -412,7 +412,7 @@ MeasurementRequest parse_measurements(std::string_view text) {
   return out;
 }
 
-Body generate_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions& options) {
+Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions& options) {
   // Complete the request: lengths scale with the height, girths with the given torso girths.
   const MeasurementRequest base = average(sex);
   MeasurementRequest r = given;
@@ -492,7 +492,7 @@ Body generate_default_body(Sex sex, const BodyBuildOptions& options) {
   MeasurementRequest request = average(sex);
   request.erase("shoulder_width");
   request.erase("back_length");
-  return generate_body(sex, request, options);
+  return make_body(sex, request, options);
 }
 
 }  // namespace drape

@@ -172,7 +172,7 @@ Body body::mh_body(const MhShape& shape, BodySkeleton skeleton) {
   return b;
 }
 
-Body make_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions& options) {
+Body make_human_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions& options) {
   const MhModel& model = body::makehuman_model();
   // Height is always fitted (the average adult's when not given); other keys only when given.
   MeasurementRequest request = given;

@@ -38,6 +38,24 @@ double signed_volume(const Mesh& m) {
   return v;
 }
 
+struct Size {
+  const char* name;
+  Sex sex;
+  float height, bust, waist, hips;
+};
+
+// Ready-to-wear size charts (approximate EU/ISO body dimensions), XS to XXL.
+const std::vector<Size>& sizes() {
+  static const std::vector<Size> all{
+      {"female XS", Sex::Female, 1.60f, 0.80f, 0.62f, 0.86f}, {"female S", Sex::Female, 1.63f, 0.86f, 0.68f, 0.92f},
+      {"female M", Sex::Female, 1.65f, 0.92f, 0.74f, 0.98f},  {"female L", Sex::Female, 1.68f, 0.98f, 0.80f, 1.04f},
+      {"female XL", Sex::Female, 1.70f, 1.06f, 0.88f, 1.11f}, {"female XXL", Sex::Female, 1.72f, 1.14f, 0.97f, 1.19f},
+      {"male XS", Sex::Male, 1.68f, 0.86f, 0.72f, 0.86f},     {"male S", Sex::Male, 1.72f, 0.92f, 0.78f, 0.92f},
+      {"male M", Sex::Male, 1.77f, 0.98f, 0.84f, 0.98f},      {"male L", Sex::Male, 1.80f, 1.04f, 0.92f, 1.03f},
+      {"male XL", Sex::Male, 1.83f, 1.12f, 1.00f, 1.09f},     {"male XXL", Sex::Male, 1.86f, 1.20f, 1.10f, 1.16f}};
+  return all;
+}
+
 void expect_valid_body(const Body& body, const std::string& what) {
   const Mesh& m = body.mesh;
   EXPECT_TRUE(body::is_closed_manifold(m)) << what << ": not watertight / not consistently oriented";
@@ -105,7 +123,61 @@ TEST(BodyMeasurements, TableHasIsoNamesForEveryField) {
   for (const auto& row : measurement_table()) EXPECT_FALSE(row.iso_8559_1.empty()) << row.key;
 }
 
-// Bodies made from measurements: tests/body/test_makehuman.cpp.
+// Bodies made on MakeHuman's body: tests/body/test_makehuman.cpp.
+
+// The generator's promise: what was asked for is what the tape measures, across sizes and sexes.
+TEST(BodyFromMeasurements, SizesXsToXxlMeasureBackWithinOneCentimetre) {
+  BodyBuildOptions options;
+  options.grid_step = 0.014f;  // the coarse fitting grid: same accuracy, faster test
+  for (const Size& size : sizes()) {
+    if (sanitized() && size.name != std::string("female XS") && size.name != std::string("male XXL")) continue;
+    const MeasurementRequest request{{"height", size.height}, {"bust", size.bust}, {"waist", size.waist}, {"hips", size.hips}};
+    const Body body = make_body(size.sex, request, options);
+    std::string line;
+    for (const auto& [key, value] : request) {
+      const auto& table = measurement_table();
+      const auto row = std::find_if(table.begin(), table.end(), [&](const MeasurementInfo& r) { return r.key == key; });
+      const float measured = body.measurements.*(row->field);
+      EXPECT_NEAR(measured, value, 0.01f) << size.name << " " << key;
+      char item[80];
+      std::snprintf(item, sizeof item, " %s %.1f/%.1f", key.c_str(), 100 * value, 100 * measured);
+      line += item;
+    }
+    std::printf("%-10s requested/measured cm:%s\n", size.name, line.c_str());
+    expect_valid_body(body, size.name);
+  }
+}
+
+// Every key at once (the controls interact: shoulder width moves the arms, the rib cage moves the
+// bust, ...), for a small woman, an average woman and an average man.
+TEST(BodyFromMeasurements, AllKeysAtOnce) {
+  if (sanitized()) GTEST_SKIP() << "slow under sanitizers";
+  BodyBuildOptions options;
+  options.grid_step = 0.014f;
+  const std::vector<std::pair<Sex, const char*>> requests{
+      {Sex::Female,
+       "height=1.60,neck=0.32,bust=0.80,underbust=0.68,waist=0.62,hips=0.86,thigh=0.50,upper_arm=0.24,"
+       "wrist=0.145,inseam=0.72,arm_length=0.53,shoulder_width=0.35,back_length=0.39"},
+      {Sex::Female,
+       "height=1.70,neck=0.34,bust=0.94,underbust=0.80,waist=0.76,hips=1.00,thigh=0.58,upper_arm=0.29,"
+       "wrist=0.16,inseam=0.77,arm_length=0.57,shoulder_width=0.37,back_length=0.41"},
+      {Sex::Male,
+       "height=1.80,neck=0.40,bust=1.02,underbust=0.92,waist=0.88,hips=1.00,thigh=0.58,upper_arm=0.32,"
+       "wrist=0.18,inseam=0.83,arm_length=0.61,shoulder_width=0.42,back_length=0.46"}};
+  for (const auto& [sex, text] : requests) {
+    const MeasurementRequest request = parse_measurements(text);
+    ASSERT_EQ(request.size(), measurement_table().size());
+    const Body body = make_body(sex, request, options);
+    float worst = 0;
+    for (const auto& row : measurement_table()) {
+      const float error = body.measurements.*row.field - request.at(std::string(row.key));
+      EXPECT_NEAR(error, 0.0f, 0.01f) << row.key << " of " << text;
+      worst = std::max(worst, std::abs(error));
+    }
+    std::printf("all keys, %s %.2f m: worst key off by %.1f mm\n", sex == Sex::Female ? "female" : "male",
+                request.at("height"), 1000 * worst);
+  }
+}
 
 TEST(BodyFromMeasurements, DefaultBodiesAreAverageAdults) {
   const Body female = default_body(Sex::Female);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -209,7 +210,7 @@ TEST(MakeHumanBody, MadeToTheMeasurementsOfEachMakeHumanBody) {
                                      {"waist", meta["waist_circ_cm"].get<float>() / 100},
                                      {"hips", meta["hip_circ_cm"].get<float>() / 100},
                                      {"inseam", meta["crotch_height_cm"].get<float>() / 100}};
-    const Body ours = make_body(d.sex, request);
+    const Body ours = make_human_body(d.sex, request);
     const Body theirs = load_body(dir / (std::string(d.name) + ".obj"));
     std::string line;
     for (const auto& [key, value] : request) {
@@ -263,6 +264,46 @@ TEST(MakeHumanBody, RiggedFromMakeHumansSkeleton) {
     EXPECT_GE(cmu.skeleton.find(name), 0) << name;
 }
 
+// The rig animates the body: the arms raised to the horizontal by linear blend skinning (every
+// joint from the upper arm down turned about the upper-arm joint) move the wrists up to the
+// shoulders and leave the torso and legs where they were.
+TEST(MakeHumanBody, ArmsRaiseByItsSkin) {
+  for (const BodySkeleton which : {BodySkeleton::Drape, BodySkeleton::CmuMb}) {
+    const Body a = body::mh_body(shape(Sex::Female, 0.5f, 0.6f), which);
+    const Skeleton& s = a.skeleton;
+    std::vector<Eigen::Affine3f> pose(s.joints.size(), Eigen::Affine3f::Identity());
+    for (const char* side : {"Left", "Right"}) {
+      const int arm = s.find(std::string(side) + "Arm"), hand = s.find(std::string(side) + "Hand");
+      ASSERT_GE(arm, 0);
+      ASSERT_GE(hand, 0);
+      const Vec3f pivot = s.joints[static_cast<size_t>(arm)].position;
+      const Vec3f axis = s.joints[static_cast<size_t>(hand)].position - pivot;
+      const float up = (axis.x() > 0 ? 1.0f : -1.0f) * std::atan2(-axis.y(), std::abs(axis.x()));
+      const Eigen::Affine3f turn =
+          Eigen::Translation3f(pivot) * Eigen::AngleAxisf(up, Vec3f::UnitZ()) * Eigen::Translation3f(-pivot);
+      for (size_t j = 0; j < s.joints.size(); ++j)
+        for (int k = static_cast<int>(j); k >= 0; k = s.joints[static_cast<size_t>(k)].parent)
+          if (k == arm) {
+            pose[j] = turn;
+            break;
+          }
+    }
+    Body t = a;
+    for (size_t v = 0; v < t.mesh.vertex_count(); ++v) {
+      Vec3f p = Vec3f::Zero();
+      for (int k = 0; k < 4; ++k) p += a.mesh.weights[v][k] * (pose[a.mesh.joints[v][static_cast<size_t>(k)]] * a.mesh.positions[v]);
+      t.mesh.positions[v] = p;
+    }
+    analyse_body(t, "raised arms");
+    const char* who = which == BodySkeleton::Drape ? "drape" : "cmu_mb";
+    EXPECT_NEAR(t.landmarks.left_wrist.y(), t.landmarks.left_shoulder.y(), 0.06f) << who;
+    EXPECT_NEAR(t.landmarks.right_wrist.y(), t.landmarks.right_shoulder.y(), 0.06f) << who;
+    EXPECT_NEAR(t.measurements.waist, a.measurements.waist, 0.01f) << who;
+    EXPECT_NEAR(t.measurements.hips, a.measurements.hips, 0.01f) << who;
+    EXPECT_NEAR(t.landmarks.crotch.y(), a.landmarks.crotch.y(), 0.01f) << who;
+  }
+}
+
 // Every size of both sexes measures back within 1 cm on height, bust, waist and hips.
 TEST(MadeBody, SizesXsToXxlMeasureBackWithinOneCentimetre) {
   struct Size {
@@ -279,7 +320,7 @@ TEST(MadeBody, SizesXsToXxlMeasureBackWithinOneCentimetre) {
       {"male XL", Sex::Male, 1.83f, 1.12f, 1.00f, 1.09f},     {"male XXL", Sex::Male, 1.86f, 1.20f, 1.10f, 1.16f}};
   for (const Size& size : sizes) {
     const MeasurementRequest request{{"height", size.height}, {"bust", size.bust}, {"waist", size.waist}, {"hips", size.hips}};
-    const Body b = make_body(size.sex, request);
+    const Body b = make_human_body(size.sex, request);
     std::string line;
     float worst = 0;
     for (const auto& [key, value] : request) {
@@ -321,7 +362,7 @@ TEST(MadeBody, AllKeysAtOnce) {
       const Measurements m = body::mh_body(s).measurements;
       for (const auto& row : measurement_table()) request[std::string(row.key)] = m.*row.field;
     }
-    const Body b = make_body(sex, request);
+    const Body b = make_human_body(sex, request);
     float worst = 0;
     std::string where;
     for (const auto& row : measurement_table()) {
@@ -347,13 +388,13 @@ TEST(MadeBody, ImpossibleCombinationsAreRefusedWithAMessage) {
       {{{"wrist", 0.30f}, {"upper_arm", 0.25f}}, "wrist"}};
   for (const auto& [request, words] : impossible) {
     try {
-      make_body(Sex::Female, request);
+      make_human_body(Sex::Female, request);
       ADD_FAILURE() << "accepted " << words;
     } catch (const InputError& e) {
       EXPECT_EQ(e.source(), "measurements");
       EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
     }
   }
-  const Body narrow = make_body(Sex::Female, {{"bust", 1.14f}, {"shoulder_width", 0.28f}});
+  const Body narrow = make_human_body(Sex::Female, {{"bust", 1.14f}, {"shoulder_width", 0.28f}});
   EXPECT_GT(std::abs(narrow.measurements.shoulder_width - 0.28f), 0.01f);
 }

@@ -132,8 +132,6 @@ struct ImplicitSolver::Impl {
   // values[block_offset[3 b + k]] (its three rows follow). Blocks 0..n-1 are the diagonal.
   SparseMatrix matrix;
   std::vector<int> block_offset;
-  std::vector<uint32_t> spring_block;          // per spring: its (a, b) block; (b, a) is spring_block_t
-  std::vector<uint32_t> spring_block_t;
   // Off-diagonal blocks and the springs that share each (CSR, in spring order).
   std::vector<uint32_t> offdiag_begin, offdiag_spring, offdiag_block, offdiag_block_t;
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky;
@@ -214,8 +212,6 @@ void ImplicitSolver::Impl::analyse_pattern() {
   std::vector<std::array<uint32_t, 2>> blocks;  // (row particle, column particle): diagonal first
   blocks.reserve(n + 2 * springs);
   for (size_t i = 0; i < n; ++i) blocks.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(i)});
-  spring_block.assign(springs, 0);
-  spring_block_t.assign(springs, 0);
   offdiag_begin.clear();
   offdiag_spring.clear();
   offdiag_block.clear();

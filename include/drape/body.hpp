@@ -1,11 +1,12 @@
 #pragma once
 // Bodies: a triangle mesh with (optionally) a skeleton and skin weights, landmarks, per-vertex body
-// parts and tape measurements. Bodies come from measurements (drape's own parametric generator, no
-// data files), from scans (OBJ/PLY) or from rigged glTF files. Every body is in drape's frame
-// (DESIGN.md): metres, +Y up, facing +Z, +X = the body's left, feet on y = 0, centred in x and z.
+// parts and tape measurements. Bodies come from measurements (made on MakeHuman's CC0 body, packed
+// into drape, or by drape's own parametric generator), from scans (OBJ/PLY) or from rigged glTF
+// files. Every body is in drape's frame (DESIGN.md): metres, +Y up, facing +Z, +X = the body's
+// left, feet on y = 0, centred in x and z.
 //
-// See docs/bodies.md for the measurement list (with ISO 8559-1 names), how the generator works and
-// how landmarks are found.
+// See docs/bodies.md for the measurement list (with ISO 8559-1 names), how bodies are made from
+// measurements and how landmarks are found.
 #include <array>
 #include <cstdint>
 #include <filesystem>

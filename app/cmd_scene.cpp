@@ -28,6 +28,7 @@ struct SceneArgs {
   int passes = 2;
   std::string fabric = "cotton";
   float time_step = 0;
+  std::string solver = "explicit";
   double max_time = 12;
   std::string out = "out";
   bool compare = true;
@@ -43,9 +44,9 @@ struct Finished {
 
 Finished simulate(const ClothSceneOptions& o, double max_time, const std::string& label) {
   Finished f{make_cloth_scene(o), {}, {}, label};
-  const float dt = f.scene.settings.time_step > 0 ? f.scene.settings.time_step : f.scene.model.stable_time_step();
-  std::fprintf(stderr, "scene %s: %u x %u cloth (%s), %s, dt %.3g s\n", std::string(to_string(o.obstacle)).c_str(), o.n,
-               o.n, o.fabric.name.c_str(), label.c_str(), dt);
+  const float dt = f.scene.time_step();
+  std::fprintf(stderr, "scene %s: %u x %u cloth (%s), %s solver, %s, dt %.3g s\n", std::string(to_string(o.obstacle)).c_str(),
+               o.n, o.n, o.fabric.name.c_str(), std::string(to_string(o.solver)).c_str(), label.c_str(), dt);
   SettleCriteria settle;
   settle.max_time = max_time;
   f.run = run_until_settled(f.scene, settle, [](const ClothState& s) {
@@ -109,6 +110,7 @@ void run_scene(const SceneArgs& a) {
   o.strain_passes = a.passes;
   if (!(a.time_step >= 0 && a.time_step < 0.1f)) throw InputError("--dt", "the time step must be in [0, 0.1) s");
   o.time_step = a.time_step;
+  o.solver = a.solver == "implicit" ? Solver::Implicit : Solver::Explicit;
   if (!(a.max_time > 0 && a.max_time <= 600)) throw InputError("--max-time", "must be in (0, 600] s");
   const float threshold = a.threshold >= 0 ? a.threshold : o.fabric.strain_threshold;
 
@@ -123,7 +125,7 @@ void run_scene(const SceneArgs& a) {
   const ClothScene& scene = main_run.scene;
   const SceneRun& run = main_run.run;
   const SceneQuality& q = main_run.quality;
-  const float dt = scene.settings.time_step > 0 ? scene.settings.time_step : scene.model.stable_time_step();
+  const float dt = scene.time_step();
 
   // report.json: DESIGN.md's quality and simulation keys, then what this scene adds.
   nlohmann::json report;
@@ -215,6 +217,10 @@ void add_scene_command(CLI::App& app) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--fabric", args->fabric, "fabric preset (cotton, denim, silk, jersey, rib_knit, wool, polyester)")
       ->capture_default_str();
+  cmd->add_option("--solver", args->solver,
+                  "explicit (the paper's explicit Euler with velocity modification) or implicit (implicit Euler, "
+                  "Newton on the incremental potential, 1/30 s steps)")
+      ->capture_default_str()->check(CLI::IsMember({"explicit", "implicit"}));
   cmd->add_option("--dt", args->time_step, "time step in seconds (default: the stability bound, eq. 4)");
   cmd->add_option("--max-time", args->max_time, "simulated seconds before giving up on settling")->capture_default_str();
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();

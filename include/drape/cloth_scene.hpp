@@ -13,6 +13,7 @@
 
 #include "drape/analytic_colliders.hpp"
 #include "drape/cloth.hpp"
+#include "drape/implicit.hpp"
 
 namespace drape {
 
@@ -26,7 +27,8 @@ struct ClothSceneOptions {
   StrainLimit strain_limit = StrainLimit::Velocity;
   float strain_threshold = -1;  // < 0: the fabric's
   int strain_passes = 2;
-  float time_step = 0;          // 0: the stability bound (eq. 4)
+  float time_step = 0;          // 0: the stability bound (eq. 4); implicit: 1/30 s
+  Solver solver = Solver::Explicit;  // implicit: implicit Euler steps (the strain limit inside the solve)
 };
 
 struct ClothScene {
@@ -34,9 +36,12 @@ struct ClothScene {
   ClothState state;
   StepSettings settings;
   StepScratch scratch;
+  std::unique_ptr<ImplicitSolver> implicit;  // set when the scene runs on the implicit solver
+  ImplicitSettings implicit_settings;
   std::vector<std::unique_ptr<AnalyticCollider>> obstacles;
   std::vector<Collider*> colliders;  // the obstacles, as step() takes them
 
+  float time_step() const;  // s, of either solver
   // Obstacles merged into one mesh (the `body` node of scene.glb).
   Mesh obstacle_mesh() const;
   // Exact inside test against the obstacles: > 0 outside.

@@ -42,6 +42,14 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
   }
   for (auto& ob : s.obstacles) s.colliders.push_back(ob.get());
   s.scratch.resize(s.model, s.colliders.size());
+  if (o.solver == Solver::Implicit) {
+    s.implicit = std::make_unique<ImplicitSolver>(s.model, s.colliders.size());
+    s.implicit_settings = default_implicit_settings(s.model);
+    // Without a strain limit the barrier never acts (a threshold no spring reaches).
+    s.implicit_settings.strain_threshold =
+        o.strain_limit == StrainLimit::None ? std::numeric_limits<float>::max() : s.settings.strain_threshold;
+    if (o.time_step > 0) s.implicit_settings.time_step = o.time_step;
+  }
   return s;
 }
 
@@ -58,6 +66,11 @@ Mesh ClothScene::obstacle_mesh() const {
   return merged;
 }
 
+float ClothScene::time_step() const {
+  if (implicit) return static_cast<float>(implicit_settings.time_step);
+  return settings.time_step > 0 ? settings.time_step : model.stable_time_step();
+}
+
 float ClothScene::obstacle_distance(const Vec3f& p) const {
   float d = std::numeric_limits<float>::infinity();
   for (const auto& ob : obstacles) d = std::min(d, ob->signed_distance(p, nullptr));
@@ -70,7 +83,8 @@ SceneRun run_until_settled(ClothScene& scene, const SettleCriteria& criteria,
   const auto start = std::chrono::steady_clock::now();
   double calm_since = -1, next_report = 0.25;
   while (scene.state.time < criteria.max_time) {
-    run.status = step(scene.model, scene.state, scene.colliders, scene.settings, scene.scratch, &run.profile);
+    run.status = scene.implicit ? scene.implicit->step(scene.state, scene.colliders, scene.implicit_settings)
+                                : step(scene.model, scene.state, scene.colliders, scene.settings, scene.scratch, &run.profile);
     if (run.status != StepStatus::Ok) break;
     const double t = scene.state.time;
     // Settled: calm (every particle slower than the threshold) for the whole window.

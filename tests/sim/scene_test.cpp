@@ -104,6 +104,19 @@ TEST(SceneCommand, WritesTheReportWithDesignKeys) {
   EXPECT_TRUE(std::filesystem::exists(dir / "preview.png"));
 }
 
+// The same scene on the implicit solver: implicit Euler at 1/30 s, the strain limit inside the solve.
+TEST(SceneCommand, ImplicitSolverSettlesWithinTheStrainLimit) {
+  const auto dir = test::temp_dir("scene_implicit");
+  const auto r = test::run_drape("scene sphere --n 16 --solver implicit --out " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(dir / "report.json");
+  const nlohmann::json report = nlohmann::json::parse(in);
+  EXPECT_TRUE(report["quality"]["settled"].get<bool>());
+  EXPECT_EQ(report["quality"]["penetrating_vertices"].get<int>(), 0);
+  EXPECT_LE(report["quality"]["max_strain"].get<double>(), 0.05 + 0.01);
+  EXPECT_NEAR(report["simulation"]["time_step_s"].get<double>(), 1.0 / 30.0, 1e-6);
+}
+
 TEST(SceneCommand, BadOptionsExitWithStatus2AndWriteNothing) {
   const auto dir = test::temp_dir("scene_bad");
   const auto r = test::run_drape("scene sphere --fabric tweed --out " + (dir / "o").string());

@@ -87,12 +87,19 @@ TEST(TableScene, SettlesOnTheTableWithoutPenetration) {
   EXPECT_LE(d.quality.strain.p99, 0.055f);
 }
 
+// `drape scene ARGS --out DIR`, which must succeed, and its report.json (null if it failed).
+nlohmann::json scene_report(const std::string& args, const std::filesystem::path& dir) {
+  const auto r = test::run_drape("scene " + args + " --out " + dir.string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (r.exit_code != 0) return nullptr;
+  std::ifstream in(dir / "report.json");
+  return nlohmann::json::parse(in);
+}
+
 TEST(SceneCommand, WritesTheReportWithDesignKeys) {
   const auto dir = test::temp_dir("scene_cmd");
-  const auto r = test::run_drape("scene sphere --n 16 --out " + dir.string());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream in(dir / "report.json");
-  const nlohmann::json report = nlohmann::json::parse(in);
+  const nlohmann::json report = scene_report("sphere --n 16", dir);
+  ASSERT_FALSE(report.is_null());
   for (const char* key : {"max_strain", "p99_strain", "penetrating_vertices", "penetration_fraction", "max_penetration_m",
                           "max_seam_gap_m", "mean_seam_gap_m", "settled", "residual"})
     EXPECT_TRUE(report["quality"].contains(key)) << key;
@@ -106,11 +113,8 @@ TEST(SceneCommand, WritesTheReportWithDesignKeys) {
 
 // The same scene on the implicit solver: implicit Euler at 1/30 s, the strain limit inside the solve.
 TEST(SceneCommand, ImplicitSolverSettlesWithinTheStrainLimit) {
-  const auto dir = test::temp_dir("scene_implicit");
-  const auto r = test::run_drape("scene sphere --n 16 --solver implicit --out " + dir.string());
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  std::ifstream in(dir / "report.json");
-  const nlohmann::json report = nlohmann::json::parse(in);
+  const nlohmann::json report = scene_report("sphere --n 16 --solver implicit", test::temp_dir("scene_implicit"));
+  ASSERT_FALSE(report.is_null());
   EXPECT_TRUE(report["quality"]["settled"].get<bool>());
   EXPECT_EQ(report["quality"]["penetrating_vertices"].get<int>(), 0);
   EXPECT_LE(report["quality"]["max_strain"].get<double>(), 0.05 + 0.01);

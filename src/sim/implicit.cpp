@@ -151,7 +151,7 @@ struct ImplicitSolver::Impl {
   std::vector<double> block_sum;
   double force_ratio = 0;  // after assemble(): the largest |gradient_i| / (m_i g)
   size_t max_colliders = 0;
-  bool analysed = false;  // the ordering and symbolic factorisation, at the first step
+  bool analysed = false;  // the pattern, ordering and symbolic factorisation: at the first step
   bool factored = false;
   bool planes_valid = false;  // contact planes found at least once  // the factorisation holds a matrix of this step
   Eigen::VectorXd residual_vec, search, product, preconditioned;  // conjugate gradients
@@ -162,9 +162,13 @@ struct ImplicitSolver::Impl {
   // Contact planes refreshed where needed (see detect_contacts), and friction's normal forces.
   void detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h, bool refresh_all);
   void lag_friction(const ImplicitSettings& s);
+  // How far `p` is inside particle i's contact layer (thickness - distance to its plane).
+  double depth(size_t i, const Vec3d& p) const {
+    return model.fabric.collision_thickness - (plane_normal[i].dot(p) + plane_offset[i]);
+  }
   std::vector<uint32_t> refresh;  // particles whose contacts are being refreshed
   double energy(const std::vector<Vec3d>& at, const ImplicitSettings& s, double h);
-  void spring_terms(const ImplicitSettings& s);
+  void spring_terms(const std::vector<Vec3d>& at, const ImplicitSettings& s);  // into spring_term
   void assemble(const ImplicitSettings& s, double h);
   float residual(const ImplicitSettings& s);
 };
@@ -178,7 +182,6 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
     const double area = m.drag_area.size() == n && m.drag_area[i] > 0 ? m.drag_area[i] : m.mass[i] / density;
     contact_k[i] = kContactStiffnessPerArea * area;
   }
-  analyse_pattern();
   x.resize(n);
   x0.resize(n);
   y.resize(n);
@@ -249,6 +252,7 @@ void ImplicitSolver::Impl::analyse_pattern() {
       block_offset[3 * b + static_cast<size_t>(k)] = static_cast<int>(found - inner);
     }
   }
+  cholesky.analyzePattern(matrix);
 }
 
 void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h,
@@ -295,18 +299,15 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
 }
 
 void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s) {
-  const double thickness = model.fabric.collision_thickness, mu = std::max(0.0f, s.friction);
+  const double mu = std::max(0.0f, s.friction);
   for (size_t i = 0; i < n; ++i)
-    friction_force[i] = in_range[i] ? mu * contact_k[i] * std::max(0.0, thickness - (plane_normal[i].dot(x[i]) + plane_offset[i])) : 0.0;
+    friction_force[i] = in_range[i] ? mu * contact_k[i] * std::max(0.0, depth(i, x[i])) : 0.0;
 }
 
 double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const ImplicitSettings& s, double h) {
   const ClothModel& m = model;
   const double inv_h2 = 1.0 / (h * h);
   const Vec3d g = s.gravity.cast<double>();
-  const double thickness = m.fabric.collision_thickness;
-  const SpringRange structural = m.range(SpringKind::Structural), seams = m.range(SpringKind::Seam);
-  const double limit = 1.0 + s.strain_threshold;
   // Particles: inertia, gravity, contact, friction.
   double total = 0;
   const size_t pblocks = sim::block_count(n);
@@ -316,7 +317,7 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       if (!free[i]) continue;
       e += 0.5 * m.inertial_mass(i) * inv_h2 * (at[i] - y[i]).squaredNorm() - m.mass[i] * g.dot(at[i]);
       if (!in_range[i]) continue;
-      const double pen = thickness - (plane_normal[i].dot(at[i]) + plane_offset[i]);
+      const double pen = depth(i, at[i]);
       if (pen > 0) e += 0.5 * contact_k[i] * pen * pen;
       if (friction_force[i] > 0) {
         Vec3d u = at[i] - x0[i] - surface_velocity[i];
@@ -328,32 +329,20 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
     block_sum[b] = e;
   });
   for (size_t b = 0; b < pblocks; ++b) total += block_sum[b];
-  // Springs.
+  // Springs: their terms at `at` (the gradients and blocks are not needed here, but one kernel
+  // keeps the energy and the forces the same function).
+  spring_terms(at, s);
   const size_t springs = m.spring_count();
   sim::parallel_blocks(springs, [&](size_t b, size_t begin, size_t end) {
     double e = 0;
-    for (size_t k = begin; k < end; ++k) {
-      const Vec3d d = at[m.spring_b[k]] - at[m.spring_a[k]];
-      const double l = d.norm();
-      if (k >= seams.begin && k < seams.end) {
-        const double ks = s.seam_stiffness, cap = s.seam_force;
-        e += cap > 0 && ks * l > cap ? cap * (l - 0.5 * cap / ks) : 0.5 * ks * l * l;
-        continue;
-      }
-      const double rest = m.rest_length[k], stiff = m.stiffness[k];
-      e += 0.5 * stiff * (l - rest) * (l - rest);
-      if (k >= structural.begin && k < structural.end) {
-        const double over = l - limit * rest;
-        if (over > 0) e += 0.5 * kLimitStiffness * stiff * over * over;
-      }
-    }
+    for (size_t k = begin; k < end; ++k) e += spring_term[k].energy;
     block_sum[b] = e;
   });
   for (size_t b = 0; b < sim::block_count(springs); ++b) total += block_sum[b];
   return total;
 }
 
-void ImplicitSolver::Impl::spring_terms(const ImplicitSettings& s) {
+void ImplicitSolver::Impl::spring_terms(const std::vector<Vec3d>& at, const ImplicitSettings& s) {
   const ClothModel& m = model;
   const SpringRange structural = m.range(SpringKind::Structural), seams = m.range(SpringKind::Seam);
   const double limit = 1.0 + s.strain_threshold;
@@ -361,7 +350,7 @@ void ImplicitSolver::Impl::spring_terms(const ImplicitSettings& s) {
     for (size_t k = begin; k < end; ++k) {
       SpringTerm& t = spring_term[k];
       t = SpringTerm{};
-      const Vec3d d = x[m.spring_b[k]] - x[m.spring_a[k]];
+      const Vec3d d = at[m.spring_b[k]] - at[m.spring_a[k]];
       const double l = d.norm();
       if (k >= seams.begin && k < seams.end) {
         add_seam(t, d, l, s.seam_stiffness, s.seam_force);
@@ -379,7 +368,6 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
   const ClothModel& m = model;
   const double inv_h2 = 1.0 / (h * h);
   const Vec3d g = s.gravity.cast<double>();
-  const double thickness = m.fabric.collision_thickness;
   double* values = matrix.valuePtr();
   const auto set_block = [&](uint32_t block, const Mat3d& a) {
     for (int k = 0; k < 3; ++k) {
@@ -387,7 +375,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
       for (int r = 0; r < 3; ++r) col[r] = a(r, k);
     }
   };
-  spring_terms(s);
+  spring_terms(x, s);
   // Per particle: diagonal block and gradient (springs in the model's incidence order).
   const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
   sim::parallel_blocks(n, [&](size_t b, size_t begin, size_t end) {
@@ -406,7 +394,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
         }
         if (in_range[i]) {
           const Vec3d& nrm = plane_normal[i];
-          const double pen = thickness - (nrm.dot(x[i]) + plane_offset[i]);
+          const double pen = depth(i, x[i]);
           if (pen > 0) {
             grad -= contact_k[i] * pen * nrm;
             diag += contact_k[i] * nrm * nrm.transpose();
@@ -478,9 +466,8 @@ float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
   // Net force per particle: springs, seams, gravity, contact, and static friction up to mu N.
   const ClothModel& m = model;
   const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
-  const double thickness = m.fabric.collision_thickness;
   const double mu = std::max(0.0f, s.friction);
-  spring_terms(s);
+  spring_terms(x, s);
   const Vec3d gravity = s.gravity.cast<double>();
   float worst = 0;
   for (size_t i = 0; i < n; ++i) {
@@ -490,7 +477,7 @@ float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
       force += static_cast<double>(m.incident_sign[q]) * spring_term[m.incident_spring[q]].gradient_b;
     if (in_range[i]) {
       const Vec3d& nrm = plane_normal[i];
-      const double pen = thickness - (nrm.dot(x[i]) + plane_offset[i]);
+      const double pen = depth(i, x[i]);
       const double normal_force = contact_k[i] * std::max(0.0, pen);
       force += normal_force * nrm;
       if (normal_force > 0) {
@@ -539,7 +526,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     w.x[i] = w.free[i] ? w.x0[i] : w.y[i];
   }
   if (!w.analysed) {
-    w.cholesky.analyzePattern(w.matrix);
+    w.analyse_pattern();
     w.analysed = true;
   }
   ImplicitStepStats st;
@@ -631,7 +618,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     st.residual = w.residual(s);
     uint32_t contacts = 0;
     for (size_t i = 0; i < w.n; ++i)
-      contacts += w.in_range[i] && w.plane_normal[i].dot(w.x[i]) + w.plane_offset[i] < w.model.fabric.collision_thickness ? 1u : 0u;
+      contacts += w.in_range[i] && w.depth(i, w.x[i]) > 0 ? 1u : 0u;
     st.contacts = contacts;
     st.max_move = std::sqrt(moved2);
     *stats = st;

@@ -1,0 +1,89 @@
+// `drape fit`: dresses a body in every size of a garment (two sizes at a time), judges each by the
+// quality gates and the fit per region, recommends one and writes DIR/report.json, fitmap.png,
+// sizes.png and fit.glb (DESIGN.md, docs/fit.md). Exit 2 on bad input (nothing written), 3 when no
+// size closes, stays on and passes every gate (outputs written; report.json says why).
+#include <omp.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "drape/error.hpp"
+#include "drape/size_advice.hpp"
+
+namespace drape::app {
+namespace {
+
+struct FitArgs {
+  std::string body = "female";
+  std::string measurements;
+  std::string garment;
+  std::string out = "out";
+  int threads = 0;
+  LoadOptions load;
+};
+
+Body load_fit_body(const FitArgs& a) {
+  if (!a.measurements.empty()) {
+    if (a.body != "female" && a.body != "male")
+      throw InputError("--measurements", "goes with --body female or male, not a body file");
+    return make_body(a.body == "male" ? Sex::Male : Sex::Female, parse_measurements(a.measurements));
+  }
+  if (a.body == "female" || a.body == "male") return default_body(a.body == "male" ? Sex::Male : Sex::Female);
+  if (!std::filesystem::exists(a.body)) throw InputError(a.body, "no such body file (or use --body female|male)");
+  return load_body(a.body, drape::load_options(a.load.units, a.load.up));
+}
+
+void run_fit(const FitArgs& a) {
+  // Everything the user gave is checked before the (long) dressing starts.
+  const GarmentSpec spec = load_garment(a.garment.empty() ? default_garment_name() : a.garment);
+  for (const std::string& size : spec.sizes) garment_in_size(spec, size);
+  const Body body = load_fit_body(a);
+  if (a.threads > 0) omp_set_num_threads(a.threads);
+
+  std::fprintf(stderr, "fitting %s in %zu sizes on a %.2f m body (bust %.3f, waist %.3f, hips %.3f m)\n",
+               spec.name.c_str(), spec.sizes.size(), static_cast<double>(body.measurements.height),
+               static_cast<double>(body.measurements.bust), static_cast<double>(body.measurements.waist),
+               static_cast<double>(body.measurements.hips));
+  const SizeAdvice advice = advise_size(body, spec, DressOptions{}, [](size_t done, size_t total) {
+    std::fprintf(stderr, "  %zu of %zu sizes dressed\n", done, total);
+  });
+  write_fit_outputs(a.out, body, advice);
+
+  for (const SizeTrial& t : advice.sizes)
+    std::fprintf(stderr, "%-4s %s %s\n", t.size.c_str(), t.result.passed() ? "passes every check," : "fails a check,   ",
+                 t.verdict.c_str());
+  if (advice.has_recommendation()) std::fprintf(stderr, "\n%s", fit_table(advice.sizes[advice.recommended].fit).c_str());
+  std::fprintf(stderr, "\n");
+  for (const std::string& line : advice.reasons) std::fprintf(stderr, "%s\n", line.c_str());
+  std::fprintf(stderr, "wrote %s/report.json, fitmap.png, sizes.png, fit.glb\n", a.out.c_str());
+  if (!advice.has_recommendation() || !advice.sizes[advice.recommended].result.passed()) {
+    std::fprintf(stderr, "drape: fit: no size of %s closes, stays on and passes every check on this body\n",
+                 spec.name.c_str());
+    std::exit(kExitQualityGate);
+  }
+}
+
+}  // namespace
+
+void add_fit_command(CLI::App& app) {
+  auto args = std::make_shared<FitArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "fit", "Dress a body in every size of a garment, map where it pulls and where it is loose, recommend a size");
+  cmd->add_option("--body", args->body, "female, male (built-in bodies) or a body file (OBJ, PLY, glTF, GLB)")
+      ->capture_default_str();
+  cmd->add_option("--measurements", args->measurements,
+                  "build the body from measurements in metres, e.g. height=1.70,bust=0.92,waist=0.74,hips=0.98");
+  cmd->add_option("--garment", args->garment,
+                  "built-in garment name (see `drape garments`) or garment file; default: the shirt");
+  cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores); sizes are dressed two at a time")
+      ->check(CLI::Range(0, 1024));
+  cmd->add_option("--out", args->out, "output directory (report.json, fitmap.png, sizes.png, fit.glb)")
+      ->capture_default_str();
+  add_load_options(*cmd, args->load);
+  cmd->callback([args] { run_fit(*args); });
+}
+
+}  // namespace drape::app

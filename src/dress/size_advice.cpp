@@ -1,0 +1,274 @@
+// Size advice (drape/size_advice.hpp, docs/fit.md): every size dressed, judged and compared.
+//
+// Sizes are dressed two at a time (an OpenMP loop over sizes, one size per thread; the dressing's
+// own parallel loops then run on one thread each). A dressing's result does not depend on the
+// number of threads it runs on, so neither does the advice.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <numeric>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/collision.hpp"
+#include "drape/size_advice.hpp"
+
+namespace drape {
+namespace {
+
+const GateResult* find_gate(const std::vector<GateResult>& gates, std::string_view name) {
+  for (const GateResult& g : gates)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
+bool gate_passed(const std::vector<GateResult>& gates, std::string_view name) {
+  const GateResult* g = find_gate(gates, name);
+  return g != nullptr && g->passed;
+}
+
+// RMS of (body - chart) / chart over the chart entry's measurements the body has (choose_size's score).
+double chart_distance(const SizeMeasurements& entry, const Measurements& body) {
+  double sum = 0;
+  size_t n = 0;
+  for (const auto& [key, chart] : entry) {
+    for (const MeasurementInfo& m : measurement_table()) {
+      if (m.key != key) continue;
+      const double b = body.*m.field;
+      if (b <= 0) continue;
+      sum += (b - chart) * (b - chart) / (chart * chart);
+      ++n;
+    }
+  }
+  return n == 0 ? -1.0 : std::sqrt(sum / static_cast<double>(n));
+}
+
+double pattern_area(const Garment& g) {
+  double area = 0;
+  for (const Panel& p : g.panels) area += std::abs(p.signed_area());
+  return area;
+}
+
+// One line: why this size does or does not fit.
+std::string size_verdict(const SizeTrial& t) {
+  if (!gate_passed(t.result.gates, "finite")) return "the simulation failed (non-finite positions)";
+  if (!t.closes) {
+    for (const DressedGarment& g : t.result.garments) {
+      const size_t seam = g.widest_seam();
+      if (seam < g.seam_names.size())
+        return fmt::format("does not close: seam '{}' stays {:.0f} mm open", g.seam_names[seam], 1e3f * g.seam_gaps()[seam]);
+    }
+    return "does not close";
+  }
+  if (!t.stays_on) return fmt::format("slides off: it fell {:.2f} m", static_cast<double>(t.result.quality.drop_m));
+  std::vector<std::string> parts;
+  for (const GarmentFit& g : t.fit.garments)
+    for (const RegionFit& r : g.regions) {
+      if (r.verdict == FitVerdict::tight) {
+        if (r.girth)
+          parts.push_back(fmt::format("tight at the {} (ease {:+.1f} cm, stretched {:.1f} %, limit {:.0f} %)", r.region,
+                                      100 * r.ease_m, 100 * r.hoop_strain, 100 * g.strain_limit));
+        else
+          parts.push_back(fmt::format("tight at the {} ({:.0f} % of the limit)", r.region, r.peak_strain_percent));
+      } else if (r.verdict == FitVerdict::loose) {
+        parts.push_back(fmt::format("loose at the {} (ease {:+.1f} cm)", r.region, 100 * r.ease_m));
+      } else if (r.verdict == FitVerdict::long_) {
+        parts.push_back(r.reason);
+      }
+    }
+  for (const GateResult& g : t.result.gates)
+    if (!g.passed) parts.push_back(g.name == "settled" ? std::string("still moving when the run stopped") : g.detail);
+  if (parts.empty()) return "fits";
+  std::string s;
+  for (const std::string& p : parts) s += (s.empty() ? "" : "; ") + p;
+  return s;
+}
+
+// "waist ease 2.1 cm, hips 4.0 cm"
+std::string ease_summary(const FitAnalysis& fit) {
+  std::string s;
+  for (const GarmentFit& g : fit.garments)
+    for (const RegionFit& r : g.regions)
+      if (r.girth) s += fmt::format("{}{} ease {:+.1f} cm", s.empty() ? "" : ", ", r.region, 100 * r.ease_m);
+  return s.empty() ? std::string("no girth line covered") : s;
+}
+
+}  // namespace
+
+FitGarment fit_garment(const DressedGarment& dressed, const Garment& garment) {
+  FitGarment f;
+  f.name = dressed.name;
+  f.size = dressed.size;
+  f.model = &dressed.model;
+  f.x = dressed.state.x;
+  f.seam_pairs = dressed.seam_pairs;
+  const size_t n = dressed.model.particle_count();
+  f.warp.assign(n, Vec2f::UnitY());
+  f.on_arm.assign(n, 0);
+  for (size_t p = 0; p + 1 < dressed.panel_first_vertex.size() && p < garment.panels.size(); ++p) {
+    const Panel& panel = garment.panels[p];
+    const Vec2f grain = panel.grain.cast<float>().normalized();
+    const bool arm = panel.placement && (panel.placement->body_part == BodyRegion::left_arm ||
+                                         panel.placement->body_part == BodyRegion::right_arm);
+    for (uint32_t i = dressed.panel_first_vertex[p]; i < dressed.panel_first_vertex[p + 1] && i < n; ++i) {
+      f.warp[i] = grain;
+      f.on_arm[i] = arm ? 1 : 0;
+    }
+  }
+  return f;
+}
+
+FitAnalysis analyse_dress_fit(const Body& body, const DressResult& result, std::span<const Garment> garments) {
+  std::vector<FitGarment> in;
+  for (size_t i = 0; i < result.garments.size() && i < garments.size(); ++i)
+    in.push_back(fit_garment(result.garments[i], garments[i]));
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  return analyse_fit(body, in, *collider);
+}
+
+SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOptions& options,
+                       const std::function<void(size_t, size_t)>& progress) {
+  SizeAdvice advice;
+  advice.garment = spec.name;
+  // Every size resolved (and validated) before anything is simulated, ordered by pattern area.
+  for (const std::string& size : spec.sizes) {
+    SizeTrial t;
+    t.size = size;
+    t.garment = garment_in_size(spec, size);
+    const auto k = static_cast<size_t>(std::find(spec.sizes.begin(), spec.sizes.end(), size) - spec.sizes.begin());
+    if (k < spec.size_chart.size() && !spec.size_chart[k].empty()) t.chart_distance = chart_distance(spec.size_chart[k], body.measurements);
+    advice.sizes.push_back(std::move(t));
+  }
+  std::stable_sort(advice.sizes.begin(), advice.sizes.end(),
+                   [](const SizeTrial& a, const SizeTrial& b) { return pattern_area(a.garment) < pattern_area(b.garment); });
+  const bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
+  if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
+
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  const auto count = static_cast<int>(advice.sizes.size());
+  std::vector<std::exception_ptr> errors(advice.sizes.size());
+  size_t done = 0;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(2)
+  for (int k = 0; k < count; ++k) {
+    SizeTrial& t = advice.sizes[static_cast<size_t>(k)];
+    try {
+      t.result = dress(body, {GarmentRequest{spec, t.size}}, options);
+      t.fit = analyse_fit(body, std::vector<FitGarment>{fit_garment(t.result.garments.at(0), t.garment)}, *collider);
+    } catch (...) {
+      errors[static_cast<size_t>(k)] = std::current_exception();
+    }
+#pragma omp critical(drape_size_advice_progress)
+    {
+      ++done;
+      if (progress) progress(done, advice.sizes.size());
+    }
+  }
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+
+  for (SizeTrial& t : advice.sizes) {
+    t.closes = gate_passed(t.result.gates, "finite") && gate_passed(t.result.gates, "seams_closed");
+    t.stays_on = gate_passed(t.result.gates, "stayed_on");
+    t.verdict = size_verdict(t);
+  }
+
+  // The rule (docs/fit.md): closes and stays on; every gate passed first; the chart's size, else
+  // the smallest not tight anywhere.
+  std::vector<size_t> candidates;
+  for (size_t k = 0; k < advice.sizes.size(); ++k)
+    if (advice.sizes[k].closes && advice.sizes[k].stays_on) candidates.push_back(k);
+  std::vector<size_t> passing;
+  for (size_t k : candidates)
+    if (advice.sizes[k].result.passed()) passing.push_back(k);
+  const std::vector<size_t>& group = passing.empty() ? candidates : passing;
+  const std::string group_words = passing.empty() ? "closes and stays on (no size passed every check)"
+                                                  : "passes every check";
+  advice.recommended = advice.sizes.size();
+  if (!group.empty()) {
+    const auto tight = [&](size_t k) {
+      for (const GarmentFit& g : advice.sizes[k].fit.garments)
+        for (const RegionFit& r : g.regions)
+          if (r.verdict == FitVerdict::tight) return true;
+      return false;
+    };
+    if (has_chart) {
+      size_t best = group.front();
+      for (size_t k : group)
+        if (advice.sizes[k].chart_distance >= 0 &&
+            (advice.sizes[best].chart_distance < 0 || advice.sizes[k].chart_distance < advice.sizes[best].chart_distance))
+          best = k;
+      advice.recommended = best;
+      advice.rule = advice.sizes[best].size == advice.chart_size
+                        ? fmt::format("the size chart's size for the body; it {}", group_words)
+                        : fmt::format("the size chart gives {}, which does not qualify; {} is the nearest in the chart that {}",
+                                      advice.chart_size, advice.sizes[best].size, group_words);
+    } else {
+      const auto loose_fit = std::find_if(group.begin(), group.end(), [&](size_t k) { return !tight(k); });
+      advice.recommended = loose_fit != group.end() ? *loose_fit : group.back();
+      advice.rule = loose_fit != group.end()
+                        ? fmt::format("no size chart: the smallest size that {} and is not tight anywhere", group_words)
+                        : fmt::format("no size chart: every size that {} is tight somewhere; the largest", group_words);
+    }
+  } else {
+    advice.rule = "no size closes and stays on the body";
+  }
+
+  if (advice.has_recommendation()) {
+    const SizeTrial& r = advice.sizes[advice.recommended];
+    advice.reasons.push_back(fmt::format("{}: recommended ({}): {}{}", r.size, advice.rule, ease_summary(r.fit),
+                                         r.verdict == "fits" ? std::string() : "; " + r.verdict));
+  } else {
+    advice.reasons.push_back("no size is recommended: none closes and stays on the body");
+  }
+  for (size_t k = 0; k < advice.sizes.size(); ++k)
+    if (k != advice.recommended) advice.reasons.push_back(fmt::format("{}: {}", advice.sizes[k].size, advice.sizes[k].verdict));
+  return advice;
+}
+
+std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
+  nlohmann::ordered_json extra;
+  extra["garment"] = advice.garment;
+  extra["recommended_size"] = advice.has_recommendation() ? nlohmann::ordered_json(advice.sizes[advice.recommended].size)
+                                                          : nlohmann::ordered_json(nullptr);
+  extra["chart_size"] = advice.chart_size.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(advice.chart_size);
+  extra["rule"] = advice.rule;
+  extra["reasons"] = advice.reasons;
+  nlohmann::ordered_json sizes = nlohmann::ordered_json::array();
+  for (size_t k = 0; k < advice.sizes.size(); ++k) {
+    const SizeTrial& t = advice.sizes[k];
+    nlohmann::ordered_json gates = nlohmann::ordered_json::array();
+    nlohmann::ordered_json failed = nlohmann::ordered_json::array();
+    for (const GateResult& g : t.result.gates) {
+      gates.push_back({{"name", g.name}, {"passed", g.passed}, {"value", std::isfinite(g.value) ? nlohmann::ordered_json(g.value) : nlohmann::ordered_json(nullptr)},
+                       {"limit", g.limit}, {"detail", g.detail}});
+      if (!g.passed) failed.push_back(g.name);
+    }
+    nlohmann::ordered_json fit = nlohmann::ordered_json::parse(fit_json(t.fit));
+    nlohmann::ordered_json regions = fit["garments"].empty() ? nlohmann::ordered_json::array() : fit["garments"][0]["regions"];
+    sizes.push_back({{"size", t.size},
+                     {"recommended", k == advice.recommended},
+                     {"verdict", t.verdict},
+                     {"closes", t.closes},
+                     {"stays_on", t.stays_on},
+                     {"chart_distance", t.chart_distance >= 0 ? nlohmann::ordered_json(t.chart_distance) : nlohmann::ordered_json(nullptr)},
+                     {"regions", regions},
+                     {"fit", fit},
+                     {"gates", {{"passed", failed.empty()}, {"failed", failed}, {"checks", gates}}},
+                     {"max_strain", t.result.quality.max_strain},
+                     {"iterations", t.result.simulation.iterations},
+                     {"wall_seconds", t.result.simulation.wall_seconds}});
+  }
+  extra["sizes"] = sizes;
+  if (advice.has_recommendation()) extra["fit"] = nlohmann::ordered_json::parse(fit_json(advice.sizes[advice.recommended].fit));
+  const Measurements& m = body.measurements;
+  extra["body"] = {{"vertices", body.mesh.vertex_count()}, {"height_m", m.height}, {"bust_m", m.bust}, {"waist_m", m.waist},
+                   {"hips_m", m.hips}, {"thigh_m", m.thigh}, {"upper_arm_m", m.upper_arm}, {"arm_length_m", m.arm_length},
+                   {"inseam_m", m.inseam}};
+  // DESIGN.md's quality, simulation and gates: of the recommended size (the smallest when none).
+  const SizeTrial& shown = advice.sizes.at(advice.has_recommendation() ? advice.recommended : 0);
+  return report_json(shown.result.quality, shown.result.simulation, shown.result.gates, extra.dump());
+}
+
+}  // namespace drape

@@ -13,6 +13,8 @@
 #include "commands.hpp"
 #include "drape/dress.hpp"
 #include "drape/error.hpp"
+#include "drape/files.hpp"
+#include "drape/size_advice.hpp"
 #include "progress.hpp"
 
 namespace drape::app {
@@ -112,7 +114,14 @@ void run_dress(const DressArgs& a) {
     progress.update(shown, p.phase);
   });
   progress.finish();
+  // The fit per region (docs/fit.md) goes into report.json's `fit` and onto the terminal.
+  std::vector<Garment> made;
+  for (size_t i = 0; i < requests.size() && i < result.garments.size(); ++i)
+    made.push_back(garment_in_size(requests[i].spec, result.garments[i].size));
+  const FitAnalysis fit = analyse_dress_fit(body, result, made);
   write_dress_outputs(a.out, body, result, o);
+  write_file_atomic(std::filesystem::path(a.out) / "report.json", report_with_fit(dress_report_json(body, result, o), fit));
+  std::fprintf(stderr, "%s", fit_table(fit).c_str());
 
   const FitQuality& q = result.quality;
   std::fprintf(stderr,

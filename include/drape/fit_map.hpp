@@ -5,9 +5,11 @@
 //             from the triangle's deformation gradient between the flat pattern (TEXCOORD_0) and
 //             3D; also as a percentage of the fabric's strain limit, as commercial fit maps show it;
 //   contact   the force the body exerts on each cloth particle at rest: the particle's force
-//             balance, -(spring forces + weight), where it lies within contact distance of the
-//             body (sewn pairs are one node: the seam holds them together), split into a normal
-//             push and a friction part of at most mu times the push;
+//             balance, -(spring forces + the strain limit's tension + weight), where it lies within
+//             contact distance of the body (sewn pairs are one node: the seam holds them
+//             together), split into a normal push and a friction part of at most mu times the
+//             push; the tension of the springs held at the limit is solved for, as the tension
+//             that best balances the cloth off the body;
 //   pressure  those forces handed to the body's vertices (Newton's third law) and divided by each
 //             vertex's area: N/m^2 on the skin;
 //   ease      the garment-to-body distance per garment vertex, and per girth line the garment's
@@ -39,9 +41,13 @@ std::array<float, 3> directional_strain(const Vec2f& a, const Vec2f& b, const Ve
 
 struct DirectionalStrain {
   std::vector<float> warp, weft, bias;  // per triangle of the model
+  // Per triangle: 0 for slivers (flat area under a quarter of the median triangle's, where a grid
+  // panel is clipped to its outline), whose deformation gradient magnifies a millimetre's error
+  // into tens of percent of strain; they count in no map or peak.
+  std::vector<uint8_t> measured;
   // Per triangle: the larger of warp and weft, the directions the fabric's strain limit holds (the
   // bias is the cloth shearing, which woven cloth does easily; it is reported, not held to the limit).
-  float along_grain(size_t t) const { return std::max(warp[t], weft[t]); }
+  float along_grain(size_t t) const { return measured[t] ? std::max(warp[t], weft[t]) : 0.0f; }
 };
 // `warp` holds one unit grain direction per particle (each panel's grain line).
 DirectionalStrain triangle_strain(const ClothModel& model, std::span<const Vec3f> x, std::span<const Vec2f> warp);
@@ -60,6 +66,7 @@ struct ContactForces {
   size_t in_contact = 0;
   Vec3f total = Vec3f::Zero();  // sum of `force`
   double weight = 0;            // N, the garment's weight (m g)
+  double unbalanced = 0;        // N, sum over the nodes of the force neither the cloth nor the body balances
 };
 // `body` answers distances (an exact collider: make_body_collider(mesh, bvh)). A particle is in
 // contact within `contact_distance` of the body (the fabric's collision thickness plus a margin).
@@ -120,23 +127,34 @@ struct RegionFit {
   float draped_m = 0;           // girth: the cut's length as draped
   float ease_m = 0;             // girth: garment_m - body_m; lengths: garment_m - body_m
   float hoop_strain = 0;        // girth: draped / pattern - 1
-  float peak_strain_percent = 0;   // largest triangle strain along the grain in the region, % of the fabric's limit
-  float peak_bias_strain = 0;      // largest stretch along the bias in the region
+  float open_seam_m = 0;        // girth: widest gap of a seam crossing the line (0: every seam closed)
+  // 95th percentiles over the region's triangles (the very highest are single triangles at an
+  // outline or an open seam): strain along the grain as % of the fabric's limit, and bias stretch.
+  float peak_strain_percent = 0;
+  float peak_bias_strain = 0;
   float peak_pressure_pa = 0;      // largest pressure on the body in the region (N/m^2)
   std::string reason;           // one line for shoppers
 };
 
 // Thresholds of the verdicts (docs/fit.md).
 struct FitThresholds {
-  // A girth line is tight when the pattern is smaller than the body there (negative ease) or the
-  // body holds the garment's cut stretched by at least this fraction of the fabric's limit.
-  float tight_hoop_fraction = 0.5f;
-  // Loose: ease above this fraction of the body's girth (bust/chest, waist, hips, thigh, upper arm).
+  // A girth line is tight when the pattern is smaller than the body there (negative ease: the
+  // cloth must stretch to go round), loose when the ease is above this fraction of the body's girth
+  // (bust/chest, waist, hips, thigh, upper arm). The cut's stretch as draped is reported, not
+  // judged: the cloth lies its collision thickness off the skin, which alone stretches a snug cut
+  // by 2 pi x 4 mm round, and soft simulation springs let a hanging garment's own weight pull it
+  // to its strain limit.
   std::array<float, 5> loose_fraction{0.15f, 0.20f, 0.15f, 0.20f, 0.30f};
-  // Neck and shoulders (no girth line): tight when this fraction of the zone's triangles are
-  // stretched to at least `zone_limit_percent` of the limit.
-  float zone_tight_fraction = 0.25f;
-  float zone_limit_percent = 90.0f;
+  // A seam that crosses a girth line (within `open_seam_band` of it) and stays open by more than
+  // `open_seam_m` (the seams gate's limit) means the garment does not close round the body there:
+  // tight, whatever the pattern's ease.
+  float open_seam_m = 0.002f;
+  float open_seam_band = 0.06f;
+  // Neck and shoulders (no girth line): tight when at least this fraction of the zone's triangles
+  // are stretched to `zone_limit_percent` of the limit or more (most of the zone held at the limit,
+  // not only the cloth the garment hangs from).
+  float zone_tight_fraction = 0.5f;
+  float zone_limit_percent = 100.0f;
 };
 
 struct GarmentFit {

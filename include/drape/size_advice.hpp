@@ -20,6 +20,8 @@ namespace drape {
 FitGarment fit_garment(const DressedGarment& dressed, const Garment& garment);
 // The fit of a dressing: `garments[i]` is the size result.garments[i] was made in.
 FitAnalysis analyse_dress_fit(const Body& body, const DressResult& result, std::span<const Garment> garments);
+// A report.json text with `fit` (fit_json) added.
+std::string report_with_fit(const std::string& report_json, const FitAnalysis& fit);
 
 // One size tried on.
 struct SizeTrial {
@@ -35,7 +37,7 @@ struct SizeTrial {
 
 struct SizeAdvice {
   std::string garment;
-  std::vector<SizeTrial> sizes;   // smallest to largest (by pattern area)
+  std::vector<SizeTrial> sizes;   // smallest to largest (the garment file's order)
   size_t recommended = 0;         // index into sizes; sizes.size() when none closes and stays on
   std::string chart_size;         // the size chart's choice for the body (empty: no chart)
   std::string rule;               // which rule chose the recommendation

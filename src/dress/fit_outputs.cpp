@@ -38,6 +38,12 @@ float nice_ceiling(float v) {
   return 10.0f * p;
 }
 
+// A garment coloured by its strain map (in its fabric's colour when it has none: a failed run).
+RenderItem strain_item(const Mesh& mesh, const GarmentFit& fit, size_t index) {
+  if (fit.strain_percent.size() != mesh.positions.size()) return garment_item(mesh, index);
+  return scalar_item(mesh, fit.strain_percent, strain_legend());
+}
+
 }  // namespace
 
 Legend strain_legend() { return Legend{"strain, % of limit", ColorMap::kViridis, 0.0f, 120.0f}; }
@@ -66,7 +72,7 @@ Image fit_map_picture(const Body& body, const DressResult& result, const FitAnal
   const Legend strain = strain_legend();
   std::vector<RenderItem> top{body_item(body.mesh)};
   for (size_t i = 0; i < meshes.size() && i < fit.garments.size(); ++i)
-    top.push_back(scalar_item(meshes[i], fit.garments[i].strain_percent, strain));
+    top.push_back(strain_item(meshes[i], fit.garments[i], i));
   RenderOptions to = o;
   to.legend = strain;
   to.title = title + ": garment strain";
@@ -98,7 +104,7 @@ Image sizes_picture(const Body& body, const SizeAdvice& advice) {
     for (const DressedGarment& g : t.result.garments) meshes.push_back(g.mesh());
     std::vector<RenderItem> items{body_item(body.mesh)};
     for (size_t i = 0; i < meshes.size() && i < t.fit.garments.size(); ++i)
-      items.push_back(scalar_item(meshes[i], t.fit.garments[i].strain_percent, strain));
+      items.push_back(strain_item(meshes[i], t.fit.garments[i], i));
     RenderOptions so = o;
     if (k + 1 == advice.sizes.size()) {
       so.legend = strain;
@@ -122,7 +128,8 @@ Scene fit_scene(const Body& body, const DressResult& result, const FitAnalysis& 
   for (size_t i = 0; i < result.garments.size() && i < fit.garments.size(); ++i) {
     Mesh m = result.garments[i].mesh();
     m.name = result.garments[i].name.empty() ? "garment" : result.garments[i].name;
-    m.colors = colorize(fit.garments[i].strain_percent, strain.map, strain.lo, strain.hi);
+    if (fit.garments[i].strain_percent.size() == m.positions.size())
+      m.colors = colorize(fit.garments[i].strain_percent, strain.map, strain.lo, strain.hi);
     const std::string name = m.name;
     add_mesh_node(scene, std::move(m), name);
   }

@@ -45,12 +45,6 @@ double chart_distance(const SizeMeasurements& entry, const Measurements& body) {
   return n == 0 ? -1.0 : std::sqrt(sum / static_cast<double>(n));
 }
 
-double pattern_area(const Garment& g) {
-  double area = 0;
-  for (const Panel& p : g.panels) area += std::abs(p.signed_area());
-  return area;
-}
-
 // One line: why this size does or does not fit.
 std::string size_verdict(const SizeTrial& t) {
   if (!gate_passed(t.result.gates, "finite")) return "the simulation failed (non-finite positions)";
@@ -128,21 +122,26 @@ FitAnalysis analyse_dress_fit(const Body& body, const DressResult& result, std::
   return analyse_fit(body, in, *collider);
 }
 
+std::string report_with_fit(const std::string& report_json, const FitAnalysis& fit) {
+  nlohmann::ordered_json report = nlohmann::ordered_json::parse(report_json);
+  report["fit"] = nlohmann::ordered_json::parse(fit_json(fit));
+  return report.dump(2) + "\n";
+}
+
 SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOptions& options,
                        const std::function<void(size_t, size_t)>& progress) {
   SizeAdvice advice;
   advice.garment = spec.name;
-  // Every size resolved (and validated) before anything is simulated, ordered by pattern area.
+  // Every size resolved (and validated) before anything is simulated, in the file's order (a
+  // pattern grades its sizes from the smallest).
   for (const std::string& size : spec.sizes) {
     SizeTrial t;
     t.size = size;
     t.garment = garment_in_size(spec, size);
-    const auto k = static_cast<size_t>(std::find(spec.sizes.begin(), spec.sizes.end(), size) - spec.sizes.begin());
+    const auto k = advice.sizes.size();
     if (k < spec.size_chart.size() && !spec.size_chart[k].empty()) t.chart_distance = chart_distance(spec.size_chart[k], body.measurements);
     advice.sizes.push_back(std::move(t));
   }
-  std::stable_sort(advice.sizes.begin(), advice.sizes.end(),
-                   [](const SizeTrial& a, const SizeTrial& b) { return pattern_area(a.garment) < pattern_area(b.garment); });
   const bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
   if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
 

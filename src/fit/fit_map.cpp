@@ -2,12 +2,14 @@
 // particle's force balance at rest, pressure on the body, and cuts of the garment by a plane.
 //
 // The dressing's contact response acts on velocities (Vassilev & Spanlang eq. 5), so it leaves no
-// force behind to read. At rest every particle's forces balance, and what the springs and gravity
-// leave unbalanced where the cloth touches the body is the body's push: f_contact = -(f_springs +
-// m g). Sewn pairs are held together by the step, not by their springs alone, so each pair is one
-// node and its two particles' forces are summed before the body's share is read. The push can only
-// point out of the body, and friction can hold at most mu times the push; what is beyond that is the
-// residual of a cloth not quite at rest, not contact.
+// force behind to read. At rest every particle's forces balance, and what the springs, the strain
+// limit's tension and gravity leave unbalanced where the cloth touches the body is the body's push:
+// f_contact = -(f_springs + f_limit + m g). Sewn pairs are held together by the step, not by their
+// springs alone, so each pair is one node and its two particles' forces are summed before the
+// body's share is read. The strain limit is a constraint with no force of its own in the state, so
+// its tensions are solved for: those that best balance the nodes off the body. The push can only
+// point out of the body, and friction can hold at most mu times the push; what is beyond that is
+// the residual of a cloth not quite at rest, not contact.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -18,6 +20,9 @@
 #include "geometry/disjoint_sets.hpp"
 
 namespace drape {
+
+// Gauss-Seidel sweeps of the strain limit's tension (a long hanging chain of springs needs many).
+constexpr int kTensionSweeps = 2000;
 
 std::array<float, 3> directional_strain(const Vec2f& a, const Vec2f& b, const Vec2f& c, const Vec3f& pa,
                                         const Vec3f& pb, const Vec3f& pc, const Vec2f& warp) {
@@ -39,7 +44,22 @@ std::array<float, 3> directional_strain(const Vec2f& a, const Vec2f& b, const Ve
 
 DirectionalStrain triangle_strain(const ClothModel& model, std::span<const Vec3f> x, std::span<const Vec2f> warp) {
   const size_t n = model.triangles.size();
-  DirectionalStrain out{std::vector<float>(n, 0.0f), std::vector<float>(n, 0.0f), std::vector<float>(n, 0.0f)};
+  DirectionalStrain out{std::vector<float>(n, 0.0f), std::vector<float>(n, 0.0f), std::vector<float>(n, 0.0f),
+                        std::vector<uint8_t>(n, 1)};
+  // Slivers: flat area under a quarter of the median.
+  std::vector<float> area(n, 0.0f);
+  for (size_t t = 0; t < n; ++t) {
+    const Tri& tri = model.triangles[t];
+    const Vec2f e1 = model.flat_position[tri[1]] - model.flat_position[tri[0]];
+    const Vec2f e2 = model.flat_position[tri[2]] - model.flat_position[tri[0]];
+    area[t] = 0.5f * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  if (n > 0) {
+    std::vector<float> sorted = area;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(n / 2), sorted.end());
+    const float floor = 0.25f * sorted[n / 2];
+    for (size_t t = 0; t < n; ++t) out.measured[t] = area[t] >= floor ? 1 : 0;
+  }
   const auto count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t k = 0; k < count; ++k) {
@@ -102,10 +122,83 @@ ContactForces contact_forces(const ClothModel& model, std::span<const Vec3f> x,
     node_net[root] += net[i];
     if (nearest[root] == UINT32_MAX || out.distance[i] < out.distance[nearest[root]]) nearest[root] = static_cast<uint32_t>(i);
   }
+  // Which nodes touch the body.
+  std::vector<uint8_t> touching(n, 0);
+  for (size_t root = 0; root < n; ++root)
+    if (nearest[root] != UINT32_MAX && out.distance[nearest[root]] <= contact_distance) touching[root] = 1;
+
+  // The strain limit's tension. A spring held at the fabric's limit pulls harder than its (soft)
+  // stiffness says: the limit stands for the cloth's real, much stiffer fibres. Its tension is
+  // unknown; it is found as the tensions t_s >= 0 of the springs at the limit that leave the least
+  // force unbalanced: on a node off the body all of its net force, on a node on the body what the
+  // body cannot take (a push out of it, with friction up to mu times the push: the distance of the
+  // force to that cone). Projected Gauss-Seidel in a fixed order, from zero tension: the least
+  // tension that holds the garment where it rests.
   const float mu = model.fabric.friction;
+  const auto unbalanced = [&](size_t root) -> Vec3f {
+    const Vec3f& f = node_net[root];
+    if (!touching[root]) return f;
+    // f + (the body's force nearest to -f): zero where the body can take all of it.
+    const Vec3f& normal = samples[nearest[root]].normal;
+    const Vec3f v = -f;
+    const float vn = v.dot(normal);
+    const Vec3f vt = v - vn * normal;
+    const float t = vt.norm();
+    Vec3f body_force = Vec3f::Zero();
+    if (t <= mu * vn) body_force = v;
+    else if (mu * t > -vn) {
+      const float pn = (vn + mu * t) / (1 + mu * mu);
+      body_force = pn * normal + (t > 0 ? Vec3f(mu * pn * vt / t) : Vec3f::Zero());
+    }
+    return f + body_force;
+  };
+  const float threshold = model.fabric.strain_threshold;
+  struct Held {
+    uint32_t a, b;
+    Vec3f u;
+    float tension;
+  };
+  std::vector<Held> held;
+  const SpringRange structural = model.range(SpringKind::Structural);
+  for (uint32_t s = structural.begin; s < structural.end; ++s) {
+    const uint32_t a = nodes.find(model.spring_a[s]), b = nodes.find(model.spring_b[s]);
+    if (a == b) continue;
+    const Vec3f d = x[model.spring_b[s]] - x[model.spring_a[s]];
+    const float length = d.norm();
+    if (!(length >= (1.0f + 0.9f * threshold) * model.rest_length[s])) continue;
+    held.push_back({a, b, d / length, 0.0f});
+  }
+  // Bottom first: a hanging strip passes its weight up through its springs in one sweep.
+  std::stable_sort(held.begin(), held.end(), [&](const Held& p, const Held& q) {
+    return std::min(x[p.a].y(), x[p.b].y()) < std::min(x[q.a].y(), x[q.b].y());
+  });
+  float largest_weight = 0;
+  for (size_t i = 0; i < n; ++i) largest_weight = std::max(largest_weight, model.mass[i] * gravity.norm());
+  const float tolerance = 1e-4f * largest_weight;
+  for (int sweep = 0; sweep < kTensionSweeps && !held.empty(); ++sweep) {
+    float change = 0;
+    // Alternating direction (symmetric Gauss-Seidel).
+    for (size_t k = 0; k < held.size(); ++k) {
+      Held& h = held[sweep % 2 == 0 ? k : held.size() - 1 - k];
+      // d/dt of 1/2 sum |unbalanced|^2 (the tension pulls a towards b: +t u on a, -t u on b); the
+      // curvature is at most 1 per end.
+      const float slope = unbalanced(h.a).dot(h.u) - unbalanced(h.b).dot(h.u);
+      const float next = std::max(0.0f, h.tension - 0.5f * slope);
+      const float d = next - h.tension;
+      if (d == 0.0f) continue;
+      node_net[h.a] += d * h.u;
+      node_net[h.b] -= d * h.u;
+      h.tension = next;
+      change = std::max(change, std::abs(d));
+    }
+    if (change < tolerance) break;
+  }
+  for (size_t root = 0; root < n; ++root)
+    if (nearest[root] != UINT32_MAX) out.unbalanced += unbalanced(root).norm();
+
   for (size_t root = 0; root < n; ++root) {
+    if (!touching[root]) continue;
     const uint32_t i = nearest[root];
-    if (i == UINT32_MAX || !(out.distance[i] <= contact_distance)) continue;
     const Vec3f normal = samples[i].normal;
     const Vec3f f = -node_net[root];
     const float push = f.dot(normal);

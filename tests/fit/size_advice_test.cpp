@@ -1,0 +1,226 @@
+// Size advice and fit per region on real dressings (drape/size_advice.hpp, docs/fit.md): the size a
+// body is recommended, the regions judged tight or loose, Newton's third law between the cloth's
+// contact forces and the body's pressure, the pictures; and `drape fit` as a user runs it.
+#include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "dress/dress_support.hpp"
+#include "drape/size_advice.hpp"
+#include "support/gltf_validator.hpp"
+#include "support/test_support.hpp"
+
+namespace drape {
+namespace {
+
+const SizeTrial& trial(const SizeAdvice& advice, const std::string& size) {
+  for (const SizeTrial& t : advice.sizes)
+    if (t.size == size) return t;
+  throw std::runtime_error("no size " + size);
+}
+
+const RegionFit* region(const SizeTrial& t, const std::string& name) {
+  for (const RegionFit& r : t.fit.garments.at(0).regions)
+    if (r.region == name) return &r;
+  return nullptr;
+}
+
+// Distinct colours and the share of pixels that differ from the top-left (backdrop) pixel.
+struct PictureStats {
+  size_t colours = 0;
+  double drawn = 0;
+};
+PictureStats stats(const Image& image) {
+  std::set<uint32_t> colours;
+  size_t drawn = 0;
+  const uint8_t* corner = image.pixel(0, 0);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const uint8_t* p = image.pixel(x, y);
+      colours.insert(uint32_t(p[0]) << 16 | uint32_t(p[1]) << 8 | p[2]);
+      if (std::abs(p[0] - corner[0]) + std::abs(p[1] - corner[1]) + std::abs(p[2] - corner[2]) > 30) ++drawn;
+    }
+  return {colours.size(), static_cast<double>(drawn) / (static_cast<double>(image.width) * image.height)};
+}
+
+// Jeans on the default female body: five sizes, each dressed (about 10 s on two cores).
+class JeansAdvice : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (test::sanitized()) return;
+    advice_ = new SizeAdvice(advise_size(test::cached_body(Sex::Female), *builtin_garment("jeans"), DressOptions{}));
+  }
+  static void TearDownTestSuite() {
+    delete advice_;
+    advice_ = nullptr;
+  }
+  void SetUp() override {
+    if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing five sizes is too slow";
+  }
+  static SizeAdvice* advice_;
+};
+SizeAdvice* JeansAdvice::advice_ = nullptr;
+
+TEST_F(JeansAdvice, RecommendsTheChartsSizeAndNeverOneThatDoesNotClose) {
+  const SizeAdvice& a = *advice_;
+  ASSERT_EQ(a.sizes.size(), 5u);
+  const std::vector<std::string> order{"XS", "S", "M", "L", "XL"};
+  for (size_t k = 0; k < order.size(); ++k) EXPECT_EQ(a.sizes[k].size, order[k]);
+  EXPECT_EQ(a.chart_size, "M");  // her waist 0.74 m and hips 0.99 m are the chart's M
+  ASSERT_TRUE(a.has_recommendation());
+  const SizeTrial& chart = trial(a, a.chart_size);
+  ASSERT_TRUE(chart.closes && chart.stays_on && chart.result.passed()) << chart.verdict;
+  EXPECT_EQ(a.sizes[a.recommended].size, "M");
+  // XS and S leave an outseam open at the hip (docs/dressing.md): never recommended, and said so.
+  for (const std::string size : {"XS", "S"}) {
+    EXPECT_FALSE(trial(a, size).closes) << size;
+    EXPECT_NE(trial(a, size).verdict.find("does not close"), std::string::npos) << trial(a, size).verdict;
+  }
+  EXPECT_EQ(a.reasons.front().rfind("M: recommended", 0), 0u) << a.reasons.front();
+}
+
+TEST_F(JeansAdvice, ASizeTooSmallIsTightWhereItIsTooSmall) {
+  const SizeAdvice& a = *advice_;
+  // S is drafted for hips of 0.95 m, hers are 0.99 m (and for a waist 4 cm under hers, which the
+  // jeans do not reach: they rest on her hips). S is tight at the hips and nowhere else.
+  const SizeTrial& s = trial(a, "S");
+  const RegionFit* hips = region(s, "hips");
+  ASSERT_NE(hips, nullptr);
+  EXPECT_EQ(hips->verdict, FitVerdict::tight) << hips->reason;
+  // Its pattern is about as wide as her hips there, with nothing to spare for the cloth round her:
+  // its outseam stays open across the hip line.
+  EXPECT_GT(hips->open_seam_m, 0.01f) << hips->reason;
+  const RegionFit* m_hips = region(trial(a, "M"), "hips");
+  ASSERT_NE(m_hips, nullptr);
+  EXPECT_LT(hips->ease_m, m_hips->ease_m);
+  EXPECT_EQ(m_hips->open_seam_m, 0.0f);
+  for (const RegionFit& r : s.fit.garments[0].regions) {
+    if (r.region != "hips") {
+      EXPECT_NE(r.verdict, FitVerdict::tight) << r.region << ": " << r.reason;
+    }
+  }
+  // M, her size, is not tight anywhere.
+  for (const RegionFit& r : trial(a, "M").fit.garments[0].regions)
+    EXPECT_NE(r.verdict, FitVerdict::tight) << "M " << r.region << ": " << r.reason;
+}
+
+TEST_F(JeansAdvice, PressureOnTheBodyBalancesTheContactForcesOnTheCloth) {
+  for (const SizeTrial& t : advice_->sizes) {
+    if (!t.closes) continue;
+    const GarmentFit& g = t.fit.garments.at(0);
+    // Newton's third law: the body gets what the cloth gets, reversed.
+    EXPECT_LT((t.fit.pressure.total + g.contacts.total).norm(), 1e-3 * g.contacts.weight) << t.size;
+    // Pressure is a push: never negative, and only where the cloth is.
+    for (float p : t.fit.pressure.pressure) ASSERT_GE(p, 0.0f);
+    EXPECT_GT(g.contacts.in_contact, 50u) << t.size;
+    EXPECT_GT(t.fit.peak_pressure_pa, 0.0f) << t.size;
+    // The body carries the jeans up (their weight less what is left unbalanced off the body).
+    EXPECT_GT(g.contacts.total.y(), 0.4 * g.contacts.weight) << t.size;
+    EXPECT_LT(g.contacts.total.y(), 1.05 * g.contacts.weight) << t.size;
+  }
+}
+
+TEST_F(JeansAdvice, PicturesAreNotBlankAndDifferBetweenSizes) {
+  const Body& body = test::cached_body(Sex::Female);
+  const SizeTrial& m = trial(*advice_, "M");
+  const SizeTrial& xl = trial(*advice_, "XL");
+  const Image a = fit_map_picture(body, m.result, m.fit, "jeans M");
+  const Image b = fit_map_picture(body, xl.result, xl.fit, "jeans XL");
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  for (const Image* image : {&a, &b}) {
+    const PictureStats s = stats(*image);
+    EXPECT_GT(s.colours, 1000u);
+    EXPECT_GT(s.drawn, 0.05);
+  }
+  size_t differ = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) differ += a.rgb[i] != b.rgb[i] ? 1 : 0;
+  EXPECT_GT(static_cast<double>(differ) / static_cast<double>(a.rgb.size()), 0.01);
+
+  const Image sizes = sizes_picture(body, *advice_);
+  EXPECT_GT(sizes.width, 5 * 300);
+  EXPECT_GT(stats(sizes).drawn, 0.05);
+
+  // fit.glb: the same colours as vertex colours, on the body and the garment.
+  const Scene scene = fit_scene(body, m.result, m.fit);
+  ASSERT_GE(scene.meshes.size(), 2u);
+  for (const Mesh& mesh : scene.meshes) EXPECT_EQ(mesh.colors.size(), mesh.positions.size()) << mesh.name;
+}
+
+nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return nlohmann::json::parse(ss.str());
+}
+
+TEST(FitCli, SkirtOnTheDefaultBodyWritesTheReportAndPictures) {
+  if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing three sizes is too slow";
+  const auto dir = test::temp_dir("fit_cli");
+  const auto r = test::run_drape("fit --garment skirt --out " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("recommended"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("hips"), std::string::npos) << r.err;  // the table of the recommended size
+
+  const nlohmann::json j = read_json(dir / "report.json");
+  EXPECT_EQ(j["recommended_size"], "M");  // the chart's size for her (waist 0.74 m, hips 0.99 m)
+  EXPECT_EQ(j["chart_size"], "M");
+  ASSERT_EQ(j["sizes"].size(), 3u);
+  const std::vector<std::string> order{"S", "M", "L"};
+  for (size_t k = 0; k < 3; ++k) {
+    const auto& s = j["sizes"][k];
+    EXPECT_EQ(s["size"], order[k]);
+    EXPECT_TRUE(s["gates"].contains("checks"));
+    EXPECT_TRUE(s["verdict"].is_string());
+    ASSERT_FALSE(s["regions"].empty());
+    for (const auto& region : s["regions"]) {
+      EXPECT_TRUE(region.contains("verdict"));
+      EXPECT_TRUE(region.contains("peak_pressure_pa"));
+    }
+  }
+  for (const char* key : {"max_strain", "p99_strain", "penetrating_vertices", "penetration_fraction", "max_penetration_m",
+                          "max_seam_gap_m", "mean_seam_gap_m", "settled", "residual"})
+    EXPECT_TRUE(j["quality"].contains(key)) << key;
+  EXPECT_TRUE(j["fit"]["garments"][0]["regions"].is_array());
+
+  for (const char* png : {"fitmap.png", "sizes.png"}) {
+    int w = 0, h = 0, channels = 0;
+    unsigned char* pixels = stbi_load((dir / png).string().c_str(), &w, &h, &channels, 3);
+    ASSERT_NE(pixels, nullptr) << png;
+    std::set<uint32_t> colours;
+    for (int i = 0; i < w * h; ++i) colours.insert(uint32_t(pixels[3 * i]) << 16 | uint32_t(pixels[3 * i + 1]) << 8 | pixels[3 * i + 2]);
+    stbi_image_free(pixels);
+    EXPECT_GT(colours.size(), 500u) << png;
+  }
+  EXPECT_TRUE(test::gltf_is_valid(dir / "fit.glb"));
+}
+
+TEST(FitCli, BadInputExitsTwoAndWritesNothing) {
+  const auto dir = test::temp_dir("fit_cli_bad");
+  const auto unknown = test::run_drape("fit --garment no_such_garment --out " + (dir / "a").string());
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("no_such_garment"), std::string::npos) << unknown.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a"));
+
+  // A file that is not a body: one small triangle.
+  const auto obj = dir / "triangle.obj";
+  std::ofstream(obj) << "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n";
+  const auto not_body = test::run_drape("fit --garment skirt --body " + obj.string() + " --out " + (dir / "b").string());
+  EXPECT_EQ(not_body.exit_code, 2);
+  EXPECT_NE(not_body.err.find("triangle.obj"), std::string::npos) << not_body.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+
+  const auto missing = test::run_drape("fit --garment skirt --body " + (dir / "nobody.obj").string() + " --out " +
+                                       (dir / "c").string());
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("nobody.obj"), std::string::npos) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "c"));
+}
+
+}  // namespace
+}  // namespace drape

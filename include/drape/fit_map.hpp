@@ -113,6 +113,7 @@ struct FitGarment {
   std::span<const std::array<uint32_t, 2>> seam_pairs;
   std::vector<Vec2f> warp;       // per particle: unit grain direction of its panel (flat pattern)
   std::vector<uint8_t> on_arm;   // per particle: 1 where its panel wraps an arm (a sleeve)
+  std::vector<uint8_t> on_leg;   // per particle: 1 where its panel wraps the left leg, 2 the right (trousers)
 };
 
 enum class FitVerdict : uint8_t { tight, good, loose, short_, long_ };

@@ -101,14 +101,20 @@ FitGarment fit_garment(const DressedGarment& dressed, const Garment& garment) {
   const size_t n = dressed.model.particle_count();
   f.warp.assign(n, Vec2f::UnitY());
   f.on_arm.assign(n, 0);
+  f.on_leg.assign(n, 0);
   for (size_t p = 0; p + 1 < dressed.panel_first_vertex.size() && p < garment.panels.size(); ++p) {
     const Panel& panel = garment.panels[p];
     const Vec2f grain = panel.grain.cast<float>().normalized();
     const bool arm = panel.placement && (panel.placement->body_part == BodyRegion::left_arm ||
                                          panel.placement->body_part == BodyRegion::right_arm);
+    const uint8_t leg = !panel.placement                                        ? 0
+                        : panel.placement->body_part == BodyRegion::left_leg  ? 1
+                        : panel.placement->body_part == BodyRegion::right_leg ? 2
+                                                                              : 0;
     for (uint32_t i = dressed.panel_first_vertex[p]; i < dressed.panel_first_vertex[p + 1] && i < n; ++i) {
       f.warp[i] = grain;
       f.on_arm[i] = arm ? 1 : 0;
+      f.on_leg[i] = leg;
     }
   }
   return f;
@@ -221,8 +227,12 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   } else {
     advice.reasons.push_back("no size is recommended: none closes and stays on the body");
   }
-  for (size_t k = 0; k < advice.sizes.size(); ++k)
-    if (k != advice.recommended) advice.reasons.push_back(fmt::format("{}: {}", advice.sizes[k].size, advice.sizes[k].verdict));
+  for (size_t k = 0; k < advice.sizes.size(); ++k) {
+    const SizeTrial& t = advice.sizes[k];
+    if (k == advice.recommended) continue;
+    advice.reasons.push_back(t.closes && t.stays_on ? fmt::format("{}: {}; {}", t.size, t.verdict, ease_summary(t.fit))
+                                                    : fmt::format("{}: {}", t.size, t.verdict));
+  }
   return advice;
 }
 

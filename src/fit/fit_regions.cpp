@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -121,17 +122,16 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
   const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
   const Vec3f arm_mid = 0.5f * (lm.left_shoulder + lm.left_elbow);
   const Vec3f arm_axis = (lm.left_elbow - lm.left_shoulder).normalized();
-  // Thighs: 6 cm below the crotch, where trousers whose crotch hangs a little low are two tubes.
+  // Thighs: from 6 cm below the crotch, lower where a garment's crotch hangs lower (per garment,
+  // below: the first line at which it is two tubes).
   const float thigh_y = lm.crotch.y() - 0.06f;
   // The body's girth at each line, as a tape lies round it (body analysis: convex hull of the section).
   const body::Slicer slicer(body.mesh);
-  const auto leg = body::leg_section(slicer, thigh_y, +1);
   const std::array<Line, 5> lines{{
       {"bust", Vec3f(0, bust_y, 0), up, 0.45f, body::torso_girth(slicer, bust_y), 0, 0, BodyPart::Torso},
       {"waist", Vec3f(0, lm.waist.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.waist.y()), 1, 0, BodyPart::Torso},
       {"hips", Vec3f(0, lm.hip.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.hip.y()), 2, 0, BodyPart::Torso},
-      {"thighs", Vec3f(lm.left_knee.x(), thigh_y, lm.left_knee.z()), up, 0.2f, leg ? body::hull_perimeter(leg->points) : 0.0f,
-       3, 1, BodyPart::LeftLeg},
+      {"thighs", Vec3f(lm.left_knee.x(), thigh_y, lm.left_knee.z()), up, 0.2f, 0.0f, 3, 1, BodyPart::LeftLeg},
       {"upper_arm", arm_mid, arm_axis, 0.12f, body::limb_girth(slicer, arm_mid, arm_axis), 4, 1, BodyPart::LeftArm},
   }};
 
@@ -202,18 +202,34 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
     }
 
     // Girth lines.
-    for (const Line& line : lines) {
+    for (Line line : lines) {
+      if (std::string_view(line.region) == "thighs") {
+        // Trousers only (panels on the legs): 6 cm below the body's crotch, or 2 cm below the
+        // garment's own crotch (the lowest pair sewing a left-leg panel to a right-leg one) when it
+        // hangs lower, so that the cut goes round one leg, not across the seat.
+        if (in.on_leg.empty()) continue;
+        float garment_crotch = std::numeric_limits<float>::infinity();
+        bool legs = false;
+        for (uint8_t leg : in.on_leg) legs = legs || leg == 1;
+        for (const auto& [a, b] : in.seam_pairs)
+          if (in.on_leg[a] != 0 && in.on_leg[b] != 0 && in.on_leg[a] != in.on_leg[b])
+            garment_crotch = std::min(garment_crotch, std::min(in.x[a].y(), in.x[b].y()));
+        if (!legs) continue;
+        const float y = std::min(thigh_y, garment_crotch - 0.02f);
+        const auto section = body::leg_section(slicer, y, +1);
+        if (!section) continue;
+        line.centre.y() = y;
+        line.body_girth = body::hull_perimeter(section->points);
+      }
       std::vector<uint8_t> selected(tris);
       for (size_t t = 0; t < tris; ++t) {
         const Tri& tri = model.triangles[t];
-        selected[t] = line.side == 0 ? !on_arm(tri) : centroid(tri).x() > 0;
+        const bool left_leg = !in.on_leg.empty() && in.on_leg[tri[0]] == 1 && in.on_leg[tri[1]] == 1 && in.on_leg[tri[2]] == 1;
+        selected[t] = line.side == 0                             ? !on_arm(tri)
+                      : std::string_view(line.region) == "thighs" ? left_leg
+                                                                  : centroid(tri).x() > 0;
       }
       const GarmentCut cut = cut_garment(model, in.x, line.centre, line.normal, line.reach, selected);
-      if (line.side != 0) {
-        // A limb line needs a tube around the limb: a skirt cut at thigh height crosses the midline.
-        const GarmentCut whole = cut_garment(model, in.x, Vec3f(0, line.centre.y(), 0), line.normal, 0.45f);
-        if (std::string_view(line.region) == "thighs" && whole.crosses_midline) continue;
-      }
       // The garment must go all the way round the body there (a hem just at the line does not).
       if (cut.segments == 0 || line.body_girth <= 0 || cut.draped_m < 0.9f * line.body_girth) continue;
       RegionFit r;

@@ -109,6 +109,18 @@ TEST_F(JeansAdvice, ASizeTooSmallIsTightWhereItIsTooSmall) {
     EXPECT_NE(r.verdict, FitVerdict::tight) << "M " << r.region << ": " << r.reason;
 }
 
+TEST_F(JeansAdvice, ASizeTooLargeIsLooseWhereItIsTooLarge) {
+  // L is drafted for hips of 1.03 m, 4 cm over hers: it rests lower on her hips, and its legs,
+  // cut straight and wide, hang loose round her thighs, looser than M's.
+  const RegionFit* l = region(trial(*advice_, "L"), "thighs");
+  const RegionFit* m = region(trial(*advice_, "M"), "thighs");
+  ASSERT_NE(l, nullptr);
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(l->verdict, FitVerdict::loose) << l->reason;
+  EXPECT_GT(l->ease_m, m->ease_m + 0.02f);
+  for (const RegionFit& r : trial(*advice_, "L").fit.garments[0].regions) EXPECT_NE(r.verdict, FitVerdict::tight) << r.reason;
+}
+
 TEST_F(JeansAdvice, PressureOnTheBodyBalancesTheContactForcesOnTheCloth) {
   for (const SizeTrial& t : advice_->sizes) {
     if (!t.closes) continue;

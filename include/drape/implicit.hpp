@@ -18,8 +18,10 @@
 // found anew every iteration, as tangent planes of the nearest collider surface.
 //
 // Two modes: dynamic (implicit Euler; stable at steps of 1/30 s and longer) and quasi-static
-// (every step starts at rest, so the inertia term is only a proximal term: the steps walk down E
-// to the state of rest, which is what dressing wants). See docs/cloth.md.
+// (every step starts at rest and the inertia term becomes a Levenberg-Marquardt damping around
+// each Newton iterate, weakened while full Newton steps succeed: the steps walk down E to the
+// state of rest, which is what dressing wants; a step's end is where contacts and friction's
+// normal forces are found anew). See docs/cloth.md.
 #include <cstdint>
 #include <memory>
 #include <span>

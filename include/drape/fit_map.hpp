@@ -145,7 +145,7 @@ struct FitThresholds {
   // judged: the cloth lies its collision thickness off the skin, which alone stretches a snug cut
   // by 2 pi x 4 mm round, and soft simulation springs let a hanging garment's own weight pull it
   // to its strain limit.
-  std::array<float, 5> loose_fraction{0.15f, 0.20f, 0.15f, 0.20f, 0.30f};
+  std::array<float, 5> loose_fraction{0.20f, 0.20f, 0.15f, 0.20f, 0.30f};
   // A seam that crosses a girth line (within `open_seam_band` of it) and stays open by more than
   // `open_seam_m` (the seams gate's limit) means the garment does not close round the body there:
   // tight, whatever the pattern's ease.

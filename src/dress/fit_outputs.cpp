@@ -111,11 +111,15 @@ Image sizes_picture(const Body& body, const SizeAdvice& advice) {
       so.width += 110;
     }
     pictures.push_back(render_views(items, so));
-    // The verdict, shortened to its first clause so it fits under the picture.
-    std::string verdict = t.verdict.substr(0, t.verdict.find(" ("));
+    // The verdict, shortened to its first clause so it fits above the picture.
+    std::string verdict = !t.closes ? std::string("does not close") : !t.stays_on ? std::string("slides off") : t.verdict;
+    verdict = verdict.substr(0, verdict.find(" ("));
     verdict = verdict.substr(0, verdict.find(';'));
-    if (verdict.size() > 34) verdict = verdict.substr(0, 31) + "...";
-    captions.push_back(fmt::format("{}{}: {}", t.size, k == advice.recommended ? " (recommended)" : "", verdict));
+    const std::string prefix = fmt::format("{}{}: ", t.size, k == advice.recommended ? " (recommended)" : "");
+    // About 12 pixels a character in the captions: keep within the picture's width.
+    const size_t room = static_cast<size_t>(std::max(8, static_cast<int>(pictures.back().width / 12) - static_cast<int>(prefix.size())));
+    if (verdict.size() > room) verdict = verdict.substr(0, room - 3) + "...";
+    captions.push_back(prefix + verdict);
   }
   return compose_side_by_side(pictures, captions);
 }

@@ -212,6 +212,25 @@ TEST(FitCli, SkirtOnTheDefaultBodyWritesTheReportAndPictures) {
   EXPECT_TRUE(test::gltf_is_valid(dir / "fit.glb"));
 }
 
+TEST(FitCli, DressReportsTheFitPerRegion) {
+  if (test::sanitized()) GTEST_SKIP() << "sanitized build: the dressing tests cover drape dress";
+  const auto dir = test::temp_dir("fit_dress");
+  const auto r = test::run_drape("dress --garment skirt --size M --out " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("fit of skirt M"), std::string::npos) << r.err;
+  const nlohmann::json j = read_json(dir / "report.json");
+  ASSERT_TRUE(j.contains("quality"));
+  const auto& regions = j["fit"]["garments"][0]["regions"];
+  ASSERT_TRUE(regions.is_array());
+  bool hips = false;
+  for (const auto& region : regions) hips = hips || region["region"] == "hips";
+  EXPECT_TRUE(hips) << regions.dump();
+  // Newton's third law in the report: the body gets what the cloth gets, reversed.
+  const auto& cloth = j["fit"]["garments"][0]["contact_force_n"];
+  const auto& body = j["fit"]["pressure_force_on_body_n"];
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(cloth[k].get<double>(), -body[k].get<double>(), 1e-3);
+}
+
 TEST(FitCli, BadInputExitsTwoAndWritesNothing) {
   const auto dir = test::temp_dir("fit_cli_bad");
   const auto unknown = test::run_drape("fit --garment no_such_garment --out " + (dir / "a").string());

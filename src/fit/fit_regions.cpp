@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -64,6 +65,108 @@ float percentile(std::vector<float>& v, double q) {
 
 std::string cm(float metres) { return fmt::format("{:.1f} cm", 100.0f * metres); }
 
+
+// The body's girth lines (bust, waist, hips, thighs, upper arm) with the body's girth at each, as
+// a tape lies round it (body analysis: the convex hull of the section). The thighs' line is moved
+// per garment (cut_at_line).
+std::array<Line, 5> girth_lines(const Body& body, const body::Slicer& slicer) {
+  const Landmarks& lm = body.landmarks;
+  const Vec3f up = Vec3f::UnitY();
+  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+  const Vec3f arm_mid = 0.5f * (lm.left_shoulder + lm.left_elbow);
+  const Vec3f arm_axis = (lm.left_elbow - lm.left_shoulder).normalized();
+  const float thigh_y = lm.crotch.y() - 0.06f;
+  return {{
+      {"bust", Vec3f(0, bust_y, 0), up, 0.45f, body::torso_girth(slicer, bust_y), 0, 0, BodyPart::Torso},
+      {"waist", Vec3f(0, lm.waist.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.waist.y()), 1, 0, BodyPart::Torso},
+      {"hips", Vec3f(0, lm.hip.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.hip.y()), 2, 0, BodyPart::Torso},
+      {"thighs", Vec3f(lm.left_knee.x(), thigh_y, lm.left_knee.z()), up, 0.2f, 0.0f, 3, 1, BodyPart::LeftLeg},
+      {"upper_arm", arm_mid, arm_axis, 0.12f, body::limb_girth(slicer, arm_mid, arm_axis), 4, 1, BodyPart::LeftArm},
+  }};
+}
+
+struct GirthCut {
+  RegionFit region;
+  Line line;                      // where it was cut
+  std::vector<uint8_t> selected;  // the garment's triangles the line's region counts
+};
+
+// The garment cut at one girth line, with its ease and verdict (tight / good / loose); nullopt
+// where the garment does not go round the body there. `judge_seams`: a seam open across the line
+// makes it tight (a dressed garment; not the placed panels, whose seams are all open).
+std::optional<GirthCut> cut_at_line(const body::Slicer& slicer, const FitGarment& in, Line line, const FitThresholds& th,
+                                    float strain_limit, bool judge_seams) {
+  const ClothModel& model = *in.model;
+  const size_t tris = model.triangles.size();
+  if (std::string_view(line.region) == "thighs") {
+    // Trousers only (panels on the legs): 6 cm below the body's crotch, or 2 cm below the
+    // garment's own crotch (the lowest pair sewing a left-leg panel to a right-leg one) when it
+    // hangs lower, so that the cut goes round one leg, not across the seat.
+    if (in.on_leg.empty()) return std::nullopt;
+    bool legs = false;
+    for (uint8_t leg : in.on_leg) legs = legs || leg == 1;
+    if (!legs) return std::nullopt;
+    float garment_crotch = std::numeric_limits<float>::infinity();
+    for (const auto& [a, b] : in.seam_pairs)
+      if (in.on_leg[a] != 0 && in.on_leg[b] != 0 && in.on_leg[a] != in.on_leg[b])
+        garment_crotch = std::min(garment_crotch, std::min(in.x[a].y(), in.x[b].y()));
+    const float y = std::min(line.centre.y(), garment_crotch - 0.02f);
+    const auto section = body::leg_section(slicer, y, +1);
+    if (!section) return std::nullopt;
+    line.centre.y() = y;
+    line.body_girth = body::hull_perimeter(section->points);
+  }
+  GirthCut out{{}, line, std::vector<uint8_t>(tris)};
+  const auto arm = [&](uint32_t v) { return !in.on_arm.empty() && in.on_arm[v] != 0; };
+  for (size_t t = 0; t < tris; ++t) {
+    const Tri& tri = model.triangles[t];
+    const bool left_leg = !in.on_leg.empty() && in.on_leg[tri[0]] == 1 && in.on_leg[tri[1]] == 1 && in.on_leg[tri[2]] == 1;
+    const Vec3f centroid = (in.x[tri[0]] + in.x[tri[1]] + in.x[tri[2]]) / 3.0f;
+    out.selected[t] = line.side == 0                             ? !(arm(tri[0]) || arm(tri[1]) || arm(tri[2]))
+                      : std::string_view(line.region) == "thighs" ? left_leg
+                                                                  : centroid.x() > 0;
+  }
+  const GarmentCut cut = cut_garment(model, in.x, line.centre, line.normal, line.reach, out.selected);
+  // The garment must go all the way round the body there (a hem just at the line does not).
+  if (cut.segments == 0 || line.body_girth <= 0 || cut.draped_m < 0.9f * line.body_girth) return std::nullopt;
+  RegionFit& r = out.region;
+  r.region = line.region;
+  r.girth = true;
+  r.body_m = line.body_girth;
+  r.garment_m = cut.pattern_m;
+  r.draped_m = cut.draped_m;
+  r.ease_m = cut.pattern_m - line.body_girth;
+  r.hoop_strain = cut.pattern_m > 0 ? cut.draped_m / cut.pattern_m - 1.0f : 0.0f;
+  if (judge_seams) {
+    for (const auto& [a, b] : in.seam_pairs) {
+      const Vec3f mid = 0.5f * (in.x[a] + in.x[b]);
+      if (std::abs((mid - line.centre).dot(line.normal)) > th.open_seam_band || (mid - line.centre).norm() > line.reach) continue;
+      if (line.side != 0 && mid.x() <= 0) continue;
+      if (line.side == 0 && (arm(a) || arm(b))) continue;
+      r.open_seam_m = std::max(r.open_seam_m, (in.x[a] - in.x[b]).norm());
+    }
+    if (r.open_seam_m <= th.open_seam_m) r.open_seam_m = 0;
+  }
+  const float loose = th.loose_fraction[line.loose_index] * line.body_girth;
+  if (r.open_seam_m > 0) {
+    r.verdict = FitVerdict::tight;
+    r.reason = fmt::format("{} is tight: the garment does not close round the body there (a seam stays {:.0f} mm open; ease {})",
+                           r.region, 1e3f * r.open_seam_m, cm(r.ease_m));
+  } else if (r.ease_m < 0) {
+    r.verdict = FitVerdict::tight;
+    r.reason = judge_seams
+                   ? fmt::format("{} is tight: the garment is {} smaller than the body ({} round) and is stretched {:.1f} % there (limit {:.0f} %)",
+                                 r.region, cm(-r.ease_m), cm(r.body_m), 100 * r.hoop_strain, 100 * strain_limit)
+                   : fmt::format("{} is tight: the pattern is {} smaller than the body ({} round)", r.region, cm(-r.ease_m),
+                                 cm(r.body_m));
+  } else if (r.ease_m > loose) {
+    r.verdict = FitVerdict::loose;
+    r.reason = fmt::format("{} is loose: ease {} (more than {})", r.region, cm(r.ease_m), cm(loose));
+  } else {
+    r.reason = fmt::format("{}: ease {}", r.region, cm(r.ease_m));
+  }
+  return out;
+}
 }  // namespace
 
 std::vector<const RegionFit*> FitAnalysis::worst_first() const {
@@ -119,21 +222,8 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
   finish_pressure(fit.pressure, body.mesh);
   for (float p : fit.pressure.pressure) fit.peak_pressure_pa = std::max(fit.peak_pressure_pa, p);
 
-  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
-  const Vec3f arm_mid = 0.5f * (lm.left_shoulder + lm.left_elbow);
-  const Vec3f arm_axis = (lm.left_elbow - lm.left_shoulder).normalized();
-  // Thighs: from 6 cm below the crotch, lower where a garment's crotch hangs lower (per garment,
-  // below: the first line at which it is two tubes).
-  const float thigh_y = lm.crotch.y() - 0.06f;
-  // The body's girth at each line, as a tape lies round it (body analysis: convex hull of the section).
   const body::Slicer slicer(body.mesh);
-  const std::array<Line, 5> lines{{
-      {"bust", Vec3f(0, bust_y, 0), up, 0.45f, body::torso_girth(slicer, bust_y), 0, 0, BodyPart::Torso},
-      {"waist", Vec3f(0, lm.waist.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.waist.y()), 1, 0, BodyPart::Torso},
-      {"hips", Vec3f(0, lm.hip.y(), 0), up, 0.45f, body::torso_girth(slicer, lm.hip.y()), 2, 0, BodyPart::Torso},
-      {"thighs", Vec3f(lm.left_knee.x(), thigh_y, lm.left_knee.z()), up, 0.2f, 0.0f, 3, 1, BodyPart::LeftLeg},
-      {"upper_arm", arm_mid, arm_axis, 0.12f, body::limb_girth(slicer, arm_mid, arm_axis), 4, 1, BodyPart::LeftArm},
-  }};
+  const std::array<Line, 5> lines = girth_lines(body, slicer);
 
   for (size_t k = 0; k < garments.size(); ++k) {
     const FitGarment& in = garments[k];
@@ -202,72 +292,16 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
     }
 
     // Girth lines.
-    for (Line line : lines) {
-      if (std::string_view(line.region) == "thighs") {
-        // Trousers only (panels on the legs): 6 cm below the body's crotch, or 2 cm below the
-        // garment's own crotch (the lowest pair sewing a left-leg panel to a right-leg one) when it
-        // hangs lower, so that the cut goes round one leg, not across the seat.
-        if (in.on_leg.empty()) continue;
-        float garment_crotch = std::numeric_limits<float>::infinity();
-        bool legs = false;
-        for (uint8_t leg : in.on_leg) legs = legs || leg == 1;
-        for (const auto& [a, b] : in.seam_pairs)
-          if (in.on_leg[a] != 0 && in.on_leg[b] != 0 && in.on_leg[a] != in.on_leg[b])
-            garment_crotch = std::min(garment_crotch, std::min(in.x[a].y(), in.x[b].y()));
-        if (!legs) continue;
-        const float y = std::min(thigh_y, garment_crotch - 0.02f);
-        const auto section = body::leg_section(slicer, y, +1);
-        if (!section) continue;
-        line.centre.y() = y;
-        line.body_girth = body::hull_perimeter(section->points);
-      }
-      std::vector<uint8_t> selected(tris);
-      for (size_t t = 0; t < tris; ++t) {
-        const Tri& tri = model.triangles[t];
-        const bool left_leg = !in.on_leg.empty() && in.on_leg[tri[0]] == 1 && in.on_leg[tri[1]] == 1 && in.on_leg[tri[2]] == 1;
-        selected[t] = line.side == 0                             ? !on_arm(tri)
-                      : std::string_view(line.region) == "thighs" ? left_leg
-                                                                  : centroid(tri).x() > 0;
-      }
-      const GarmentCut cut = cut_garment(model, in.x, line.centre, line.normal, line.reach, selected);
-      // The garment must go all the way round the body there (a hem just at the line does not).
-      if (cut.segments == 0 || line.body_girth <= 0 || cut.draped_m < 0.9f * line.body_girth) continue;
-      RegionFit r;
-      r.region = line.region;
-      r.girth = true;
-      r.body_m = line.body_girth;
-      r.garment_m = cut.pattern_m;
-      r.draped_m = cut.draped_m;
-      r.ease_m = cut.pattern_m - line.body_girth;
-      r.hoop_strain = cut.pattern_m > 0 ? cut.draped_m / cut.pattern_m - 1.0f : 0.0f;
-      r.peak_strain_percent = zone_strain(selected, [&](const Vec3f& p) {
+    for (const Line& base : lines) {
+      std::optional<GirthCut> cut = cut_at_line(slicer, in, base, th, g.strain_limit, true);
+      if (!cut) continue;
+      RegionFit& r = cut->region;
+      const Line& line = cut->line;
+      r.peak_strain_percent = zone_strain(cut->selected, [&](const Vec3f& p) {
         return std::abs((p - line.centre).dot(line.normal)) < kBand && (p - line.centre).norm() < line.reach;
       }, nullptr, nullptr);
       r.peak_bias_strain = bias;
       r.peak_pressure_pa = peak_pressure(body, fit.pressure, line.centre, line.normal, line.reach, line.part);
-      for (const auto& [a, b] : in.seam_pairs) {
-        const Vec3f mid = 0.5f * (in.x[a] + in.x[b]);
-        if (std::abs((mid - line.centre).dot(line.normal)) > th.open_seam_band || (mid - line.centre).norm() > line.reach) continue;
-        if (line.side != 0 && mid.x() <= 0) continue;
-        if (line.side == 0 && !in.on_arm.empty() && (in.on_arm[a] || in.on_arm[b])) continue;
-        r.open_seam_m = std::max(r.open_seam_m, (in.x[a] - in.x[b]).norm());
-      }
-      if (r.open_seam_m <= th.open_seam_m) r.open_seam_m = 0;
-      const float loose = th.loose_fraction[line.loose_index] * line.body_girth;
-      if (r.open_seam_m > 0) {
-        r.verdict = FitVerdict::tight;
-        r.reason = fmt::format("{} is tight: the garment does not close round the body there (a seam stays {:.0f} mm open; ease {})",
-                               r.region, 1e3f * r.open_seam_m, cm(r.ease_m));
-      } else if (r.ease_m < 0) {
-        r.verdict = FitVerdict::tight;
-        r.reason = fmt::format("{} is tight: the garment is {} smaller than the body ({} round) and is stretched {:.1f} % there (limit {:.0f} %)",
-                               r.region, cm(-r.ease_m), cm(r.body_m), 100 * r.hoop_strain, 100 * g.strain_limit);
-      } else if (r.ease_m > loose) {
-        r.verdict = FitVerdict::loose;
-        r.reason = fmt::format("{} is loose: ease {} (more than {})", r.region, cm(r.ease_m), cm(loose));
-      } else {
-        r.reason = fmt::format("{}: ease {}", r.region, cm(r.ease_m));
-      }
       g.regions.push_back(std::move(r));
     }
 
@@ -339,6 +373,15 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
     }
   }
   return fit;
+}
+
+std::vector<RegionFit> pattern_girths(const Body& body, const FitGarment& placed, const FitThresholds& thresholds) {
+  std::vector<RegionFit> out;
+  const body::Slicer slicer(body.mesh);
+  for (const Line& line : girth_lines(body, slicer))
+    if (auto cut = cut_at_line(slicer, placed, line, thresholds, placed.model->fabric.strain_threshold, false))
+      out.push_back(std::move(cut->region));
+  return out;
 }
 
 std::string fit_json(const FitAnalysis& fit) {

@@ -2,6 +2,7 @@
 // quality gates and the fit per region, recommends one and writes DIR/report.json, fitmap.png,
 // sizes.png and fit.glb (DESIGN.md, docs/fit.md). Exit 2 on bad input (nothing written), 3 when no
 // size closes, stays on and passes every gate (outputs written; report.json says why).
+#include <fmt/format.h>
 #include <omp.h>
 
 #include <cstdio>
@@ -52,9 +53,14 @@ void run_fit(const FitArgs& a) {
   });
   write_fit_outputs(a.out, body, advice);
 
-  for (const SizeTrial& t : advice.sizes)
+  for (const SizeTrial& t : advice.sizes) {
     std::fprintf(stderr, "%-4s %s %s\n", t.size.c_str(), t.result.passed() ? "passes every check," : "fails a check,   ",
                  t.verdict.c_str());
+    std::string pattern;
+    for (const RegionFit& r : t.pattern)
+      pattern += fmt::format("{}{} {:+.1f} cm ({})", pattern.empty() ? "" : ", ", r.region, 100 * r.ease_m, to_string(r.verdict));
+    if (!pattern.empty()) std::fprintf(stderr, "     on the pattern, before draping: %s\n", pattern.c_str());
+  }
   if (advice.has_recommendation()) std::fprintf(stderr, "\n%s", fit_table(advice.sizes[advice.recommended].fit).c_str());
   std::fprintf(stderr, "\n");
   for (const std::string& line : advice.reasons) std::fprintf(stderr, "%s\n", line.c_str());

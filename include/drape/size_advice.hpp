@@ -29,6 +29,8 @@ struct SizeTrial {
   Garment garment;   // the size's pattern
   DressResult result;
   FitAnalysis fit;
+  // Girths on the pattern before draping: the panels placed round the body, cut at its lines.
+  std::vector<RegionFit> pattern;
   bool closes = false;    // every seam closed (and the simulation stayed finite)
   bool stays_on = false;  // the garment did not slide off
   double chart_distance = -1;  // RMS relative distance of the body to the size's chart entry (-1: none)

@@ -152,6 +152,14 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
 
   const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  // Before draping: each size's pattern placed round the body and measured at its girth lines.
+  {
+    const auto placement_collider = make_body_collider(body.mesh, options.collision);
+    for (SizeTrial& t : advice.sizes) {
+      const DressedGarment placed = prepare_garment(body, t.garment, *placement_collider, options);
+      t.pattern = pattern_girths(body, fit_garment(placed, t.garment));
+    }
+  }
   const auto count = static_cast<int>(advice.sizes.size());
   std::vector<std::exception_ptr> errors(advice.sizes.size());
   size_t done = 0;
@@ -256,6 +264,10 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
     }
     nlohmann::ordered_json fit = nlohmann::ordered_json::parse(fit_json(t.fit));
     nlohmann::ordered_json regions = fit["garments"].empty() ? nlohmann::ordered_json::array() : fit["garments"][0]["regions"];
+    nlohmann::ordered_json pattern = nlohmann::ordered_json::array();
+    for (const RegionFit& r : t.pattern)
+      pattern.push_back({{"region", r.region}, {"verdict", std::string(to_string(r.verdict))}, {"ease_cm", 100.0 * r.ease_m},
+                         {"garment_girth_m", r.garment_m}, {"body_girth_m", r.body_m}});
     sizes.push_back({{"size", t.size},
                      {"recommended", k == advice.recommended},
                      {"verdict", t.verdict},
@@ -263,6 +275,7 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
                      {"stays_on", t.stays_on},
                      {"chart_distance", t.chart_distance >= 0 ? nlohmann::ordered_json(t.chart_distance) : nlohmann::ordered_json(nullptr)},
                      {"regions", regions},
+                     {"pattern_girths", pattern},
                      {"fit", fit},
                      {"gates", {{"passed", failed.empty()}, {"failed", failed}, {"checks", gates}}},
                      {"max_strain", t.result.quality.max_strain},

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <stb_image.h>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -107,6 +108,23 @@ TEST_F(JeansAdvice, ASizeTooSmallIsTightWhereItIsTooSmall) {
   // M, her size, is not tight anywhere.
   for (const RegionFit& r : trial(a, "M").fit.garments[0].regions)
     EXPECT_NE(r.verdict, FitVerdict::tight) << "M " << r.region << ": " << r.reason;
+}
+
+TEST_F(JeansAdvice, PatternGirthsBeforeDrapingFollowTheChart) {
+  // Measured on the placed, unsewn panels at her hip line: the pattern grows with the size, and a
+  // size drafted for hips smaller than hers (XS 0.88 m, S 0.95 m; hers 0.99 m) is tight there
+  // before any draping, one drafted for hers or more (M 0.99 m, L 1.03 m) is not.
+  std::vector<float> hips;
+  for (const std::string size : {"XS", "S", "M", "L"}) {
+    const SizeTrial& t = trial(*advice_, size);
+    const auto it = std::find_if(t.pattern.begin(), t.pattern.end(), [](const RegionFit& r) { return r.region == "hips"; });
+    ASSERT_NE(it, t.pattern.end()) << size;
+    hips.push_back(it->garment_m);
+    const bool smaller = size == "XS" || size == "S";
+    EXPECT_EQ(it->verdict == FitVerdict::tight, smaller) << size << ": " << it->reason;
+    EXPECT_EQ(it->ease_m < 0, smaller) << size;
+  }
+  for (size_t k = 1; k < hips.size(); ++k) EXPECT_GT(hips[k], hips[k - 1] + 0.01f);
 }
 
 TEST_F(JeansAdvice, ASizeTooLargeIsLooseWhereItIsTooLarge) {

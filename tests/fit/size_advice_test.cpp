@@ -2,6 +2,7 @@
 // body is recommended, the regions judged tight or loose, Newton's third law between the cloth's
 // contact forces and the body's pressure, the pictures; and `drape fit` as a user runs it.
 #include <gtest/gtest.h>
+#include <omp.h>
 #include <stb_image.h>
 
 #include <algorithm>
@@ -180,6 +181,43 @@ TEST_F(JeansAdvice, PicturesAreNotBlankAndDifferBetweenSizes) {
   const Scene scene = fit_scene(body, m.result, m.fit);
   ASSERT_GE(scene.meshes.size(), 2u);
   for (const Mesh& mesh : scene.meshes) EXPECT_EQ(mesh.colors.size(), mesh.positions.size()) << mesh.name;
+}
+
+TEST_F(JeansAdvice, FitDoesNotDependOnTheThreadCount) {
+  const Body& body = test::cached_body(Sex::Female);
+  const SizeTrial& m = trial(*advice_, "M");
+  const std::vector<Garment> made{m.garment};
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const FitAnalysis one = analyse_dress_fit(body, m.result, made);
+  omp_set_num_threads(2);
+  const FitAnalysis two = analyse_dress_fit(body, m.result, made);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(fit_json(one), fit_json(two));
+  EXPECT_EQ(one.pressure.pressure, two.pressure.pressure);
+  EXPECT_EQ(one.garments[0].strain_percent, two.garments[0].strain_percent);
+}
+
+// The default male body in the shirt: the chart gives XL, the men's cut, and the women's S, M, L
+// leave a seam open under his arms (docs/dressing.md).
+TEST(ShirtAdvice, DefaultMaleBodyGetsTheChartsXL) {
+  if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing four sizes is too slow";
+  const SizeAdvice a = advise_size(test::cached_body(Sex::Male), *builtin_garment("shirt"), DressOptions{});
+  EXPECT_EQ(a.chart_size, "XL");
+  ASSERT_TRUE(a.has_recommendation());
+  const SizeTrial& chart = trial(a, "XL");
+  ASSERT_TRUE(chart.closes && chart.stays_on && chart.result.passed()) << chart.verdict;
+  EXPECT_EQ(a.sizes[a.recommended].size, "XL");
+  for (const std::string size : {"S", "M", "L"}) {
+    const SizeTrial& t = trial(a, size);
+    if (t.closes) continue;
+    // Not closing under his arms: judged tight at the upper arm (the sleeve's underarm seam).
+    const RegionFit* arm = region(t, "upper_arm");
+    ASSERT_NE(arm, nullptr) << size;
+    if (arm->open_seam_m > 0) {
+      EXPECT_EQ(arm->verdict, FitVerdict::tight) << size << ": " << arm->reason;
+    }
+  }
 }
 
 nlohmann::json read_json(const std::filesystem::path& p) {

@@ -55,7 +55,8 @@ struct SizeAdvice {
 //      body: the size whose ease on this body is nearest the ease its pattern was drafted with);
 //      without a chart, the smallest size not tight anywhere (the largest when all are tight).
 // `progress` (may be empty) is called after each size with the number done; sizes run in
-// parallel, two at a time, and the result does not depend on the thread count.
+// parallel, two at a time (one with a single OpenMP thread), and the result does not depend on
+// the thread count.
 SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOptions& options,
                        const std::function<void(size_t done, size_t total)>& progress = {});
 

@@ -4,6 +4,7 @@
 // own parallel loops then run on one thread each). A dressing's result does not depend on the
 // number of threads it runs on, so neither does the advice.
 #include <fmt/format.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -163,7 +164,8 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   const auto count = static_cast<int>(advice.sizes.size());
   std::vector<std::exception_ptr> errors(advice.sizes.size());
   size_t done = 0;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(2)
+  const int threads = std::min(2, omp_get_max_threads());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
   for (int k = 0; k < count; ++k) {
     SizeTrial& t = advice.sizes[static_cast<size_t>(k)];
     try {

@@ -22,6 +22,7 @@ struct FitArgs {
   std::string measurements;
   std::string garment;
   std::string out = "out";
+  std::string solver = std::string(to_string(DressOptions{}.solver));
   int threads = 0;
   LoadOptions load;
 };
@@ -48,7 +49,9 @@ void run_fit(const FitArgs& a) {
                spec.name.c_str(), spec.sizes.size(), static_cast<double>(body.measurements.height),
                static_cast<double>(body.measurements.bust), static_cast<double>(body.measurements.waist),
                static_cast<double>(body.measurements.hips));
-  const SizeAdvice advice = advise_size(body, spec, DressOptions{}, [](size_t done, size_t total) {
+  DressOptions options;
+  options.solver = a.solver == "explicit" ? Solver::Explicit : Solver::Implicit;
+  const SizeAdvice advice = advise_size(body, spec, options, [](size_t done, size_t total) {
     std::fprintf(stderr, "  %zu of %zu sizes dressed\n", done, total);
   });
   write_fit_outputs(a.out, body, advice);
@@ -84,6 +87,10 @@ void add_fit_command(CLI::App& app) {
                   "build the body from measurements in metres, e.g. height=1.70,bust=0.92,waist=0.74,hips=0.98");
   cmd->add_option("--garment", args->garment,
                   "built-in garment name (see `drape garments`) or garment file; default: the shirt");
+  cmd->add_option("--solver", args->solver,
+                  "implicit (Newton on the incremental potential) or explicit (the paper's explicit Euler with "
+                  "velocity modification); see drape dress --help")
+      ->capture_default_str()->check(CLI::IsMember({"implicit", "explicit"}));
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores); sizes are dressed two at a time")
       ->check(CLI::Range(0, 1024));
   cmd->add_option("--out", args->out, "output directory (report.json, fitmap.png, sizes.png, fit.glb)")

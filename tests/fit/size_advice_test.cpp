@@ -50,12 +50,20 @@ PictureStats stats(const Image& image) {
   return {colours.size(), static_cast<double>(drawn) / (static_cast<double>(image.width) * image.height)};
 }
 
+// The outcomes these tests name (which sizes close, where) are the explicit solver's
+// (docs/dressing.md, "Status").
+DressOptions explicit_solver() {
+  DressOptions o;
+  o.solver = Solver::Explicit;
+  return o;
+}
+
 // Jeans on the default female body: five sizes, each dressed (about 10 s on two cores).
 class JeansAdvice : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     if (test::sanitized()) return;
-    advice_ = new SizeAdvice(advise_size(test::cached_body(Sex::Female), *builtin_garment("jeans"), DressOptions{}));
+    advice_ = new SizeAdvice(advise_size(test::cached_body(Sex::Female), *builtin_garment("jeans"), explicit_solver()));
   }
   static void TearDownTestSuite() {
     delete advice_;
@@ -202,7 +210,7 @@ TEST_F(JeansAdvice, FitDoesNotDependOnTheThreadCount) {
 // leave a seam open under his arms (docs/dressing.md).
 TEST(ShirtAdvice, DefaultMaleBodyGetsTheChartsXL) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing four sizes is too slow";
-  const SizeAdvice a = advise_size(test::cached_body(Sex::Male), *builtin_garment("shirt"), DressOptions{});
+  const SizeAdvice a = advise_size(test::cached_body(Sex::Male), *builtin_garment("shirt"), explicit_solver());
   EXPECT_EQ(a.chart_size, "XL");
   ASSERT_TRUE(a.has_recommendation());
   const SizeTrial& chart = trial(a, "XL");
@@ -230,7 +238,7 @@ nlohmann::json read_json(const std::filesystem::path& p) {
 TEST(FitCli, SkirtOnTheDefaultBodyWritesTheReportAndPictures) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing three sizes is too slow";
   const auto dir = test::temp_dir("fit_cli");
-  const auto r = test::run_drape("fit --garment skirt --out " + dir.string());
+  const auto r = test::run_drape("fit --garment skirt --solver explicit --out " + dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("recommended"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("hips"), std::string::npos) << r.err;  // the table of the recommended size
@@ -271,7 +279,7 @@ TEST(FitCli, SkirtOnTheDefaultBodyWritesTheReportAndPictures) {
 TEST(FitCli, DressReportsTheFitPerRegion) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: the dressing tests cover drape dress";
   const auto dir = test::temp_dir("fit_dress");
-  const auto r = test::run_drape("dress --garment skirt --size M --out " + dir.string());
+  const auto r = test::run_drape("dress --garment skirt --size M --solver explicit --out " + dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("fit of skirt M"), std::string::npos) << r.err;
   const nlohmann::json j = read_json(dir / "report.json");

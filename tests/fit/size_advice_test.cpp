@@ -228,6 +228,25 @@ TEST(ShirtAdvice, DefaultMaleBodyGetsTheChartsXL) {
   }
 }
 
+// A shared body: the average female MakeHuman body (waist 0.65 m) in the skirt. Her chart size S
+// fits; M and L, drafted for waists of 0.74 and 0.84 m, slide off her and are never recommended.
+TEST(SkirtAdvice, AverageMakeHumanWomanGetsTheChartsSAndNoSizeThatSlidesOff) {
+  if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing three sizes is too slow";
+  const auto path = DRAPE_REQUIRE_SHARED("bodies/makehuman/derived/mh_female_average.obj");
+  const Body body = load_body(path);
+  const SizeAdvice a = advise_size(body, *builtin_garment("skirt"), explicit_solver());
+  EXPECT_EQ(a.chart_size, "S");
+  ASSERT_TRUE(a.has_recommendation());
+  const SizeTrial& chart = trial(a, "S");
+  ASSERT_TRUE(chart.closes && chart.stays_on && chart.result.passed()) << chart.verdict;
+  EXPECT_EQ(a.sizes[a.recommended].size, "S");
+  for (const SizeTrial& t : a.sizes)
+    if (!t.stays_on) {
+      EXPECT_NE(a.sizes[a.recommended].size, t.size);
+      EXPECT_NE(t.verdict.find("slides off"), std::string::npos) << t.verdict;
+    }
+}
+
 nlohmann::json read_json(const std::filesystem::path& p) {
   std::ifstream in(p);
   std::stringstream ss;

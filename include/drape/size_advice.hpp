@@ -64,8 +64,8 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
 std::string size_advice_json(const Body& body, const SizeAdvice& advice);
 
 // Pictures: the fit map of one dressing (front, side, back: garments by strain as a percentage of
-// the limit; below, the body by pressure), the sizes side by side labelled with their verdicts,
-// and the fit map as a glTF scene with vertex colours.
+// the limit; then by ease, their distance to the skin; below, the body by pressure), the sizes
+// side by side labelled with their verdicts, and the fit map as a glTF scene with vertex colours.
 Image fit_map_picture(const Body& body, const DressResult& result, const FitAnalysis& fit, const std::string& title);
 Image sizes_picture(const Body& body, const SizeAdvice& advice);
 Scene fit_scene(const Body& body, const DressResult& result, const FitAnalysis& fit);

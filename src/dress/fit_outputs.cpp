@@ -78,13 +78,31 @@ Image fit_map_picture(const Body& body, const DressResult& result, const FitAnal
   to.title = title + ": garment strain";
   const Image upper = render_views(top, to);
 
+  // Ease: each garment vertex's distance to the skin, in cm.
+  const Legend ease{"ease, cm", ColorMap::kViridis, 0.0f, 5.0f};
+  std::vector<std::vector<float>> ease_cm(meshes.size());
+  std::vector<RenderItem> middle{body_item(body.mesh)};
+  for (size_t i = 0; i < meshes.size() && i < fit.garments.size(); ++i) {
+    const std::vector<float>& d = fit.garments[i].contacts.distance;
+    if (d.size() != meshes[i].positions.size()) {
+      middle.push_back(garment_item(meshes[i], i));
+      continue;
+    }
+    for (float v : d) ease_cm[i].push_back(std::isfinite(v) ? 100.0f * std::max(0.0f, v) : ease.hi);
+    middle.push_back(scalar_item(meshes[i], ease_cm[i], ease));
+  }
+  RenderOptions mo = o;
+  mo.legend = ease;
+  mo.title = "ease: garment to body";
+  const Image centre = render_views(middle, mo);
+
   const Legend pressure = pressure_legend(fit);
   std::vector<RenderItem> bottom{scalar_item(body.mesh, fit.pressure.pressure, pressure)};
   RenderOptions bo = o;
   bo.legend = pressure;
   bo.title = fmt::format("pressure on the body (peak {:.0f} N/m2)", fit.peak_pressure_pa);
   const Image lower = render_views(bottom, bo);
-  return stack({upper, lower});
+  return stack({upper, centre, lower});
 }
 
 Image sizes_picture(const Body& body, const SizeAdvice& advice) {

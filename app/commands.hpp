@@ -19,6 +19,7 @@ void add_garment_command(CLI::App& app);  // cmd_garment.cpp: `garments`, `garme
 void add_dress_command(CLI::App& app);  // cmd_dress.cpp: dress a body in garments (paper sec. 6)
 void add_body_command(CLI::App& app);     // cmd_body.cpp: a rigged body from measurements
 void add_measure_command(CLI::App& app);  // cmd_measure.cpp: landmarks and measurements of a body
+void add_animate_command(CLI::App& app);  // cmd_animate.cpp: a dressed body in motion
 void add_fit_command(CLI::App& app);      // cmd_fit.cpp: every size tried on, fit maps, a size recommended
 
 }  // namespace drape::app

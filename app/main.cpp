@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   drape::app::add_dress_command(app);
   drape::app::add_body_command(app);
   drape::app::add_measure_command(app);
+  drape::app::add_animate_command(app);
   drape::app::add_fit_command(app);
 
   try {

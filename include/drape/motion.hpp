@@ -114,7 +114,8 @@ struct RetargetOptions {
   long first_frame = 0;             // in the motion's frames, after a skipped calibration frame
   long last_frame = -1;             // inclusive; -1: the last
   bool skip_calibration = true;     // drop a calibration T-pose in the motion's first frame
-  double blend_seconds = 0.5;       // lead-in from the body's bind pose (the dressed pose) to the motion
+  double blend_seconds = 0.5;       // lead-in: the motion's weight against the bind pose (the dressed pose)
+                                    // rises from 0 to 1 over this time while the motion plays
   const JointMap* motion_map = nullptr;  // nullptr: find_joint_map on the motion's names
 };
 
@@ -146,7 +147,7 @@ struct BodyAnimation {
   std::string motion_convention, body_convention;
   std::vector<std::string> mapped;  // "Hips <- Hips", per canonical joint found on both sides
   float root_scale = 1;              // body leg length / motion leg length (motion units -> m)
-  size_t blend_frames = 0;           // lead-in frames from the bind pose
+  size_t blend_frames = 0;           // first frames blended from the bind pose (the motion plays under them)
   bool skipped_calibration = false;  // the motion's first frame was a calibration T-pose
   long motion_first = 0, motion_last = 0;  // the motion frames used (of the file's)
   FootReport feet;

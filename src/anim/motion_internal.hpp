@@ -19,7 +19,7 @@ void convert_axes(Motion& motion, const MotionOptions& options);
 // Index of a canonical joint (canonical_joints() order) by name; -1 when not canonical.
 int canonical_index(std::string_view name);
 
-// Shifts the animation's frames after the lead-in vertically so that the lowest foot vertex of the
+// Shifts the animation's frames (from out.blend_frames on) vertically so that the lowest foot vertex of the
 // clip is on y = 0 (out.feet.floor_shift_m), taking off a capture floor's tilt over time
 // (out.feet.floor_slope_m_per_s).
 void place_on_floor(const Body& body, const JointMap& body_map, BodyAnimation& out);

@@ -131,6 +131,19 @@ bool is_calibration_frame(const Motion& m, const JointMap& map, const Quatf& fac
   return jump > 10.0f * static_cast<float>(M_PI) / 180.0f;
 }
 
+// A body wider at the hips than the captured person (or in an A-pose it was rigged in) puts its
+// hanging arms through its sides. The upper arm is turned outwards, about the chest's forward axis,
+// until it hangs at least kMinArmAbduction from the chest's down direction, seen from the front.
+constexpr float kMinArmAbduction = 20.0f * static_cast<float>(M_PI) / 180.0f;
+void keep_arm_off_torso(Quatf& arm, const Vec3f& bind_dir, const Quatf& chest, float side) {
+  const Vec3f d = arm * bind_dir;
+  const Vec3f out = chest * Vec3f(side, 0, 0), down = chest * Vec3f(0, -1, 0), forward = chest * Vec3f::UnitZ();
+  if (d.dot(down) <= 0) return;
+  const float angle = std::atan2(d.dot(out), d.dot(down));
+  if (angle >= kMinArmAbduction) return;
+  arm = (Quatf(Eigen::AngleAxisf(kMinArmAbduction - angle, side * forward)) * arm).normalized();
+}
+
 }  // namespace
 
 BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions& o) {
@@ -214,9 +227,10 @@ BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions&
   out.motion_first = first + first_available;
   out.motion_last = last + first_available;
   const double duration = static_cast<double>(out.motion_last - out.motion_first) * m.frame_time;
-  const size_t motion_frames = static_cast<size_t>(std::floor(duration * o.fps + 1e-9)) + 1;
-  out.blend_frames = static_cast<size_t>(std::lround(std::max(0.0, o.blend_seconds) * o.fps));
-  out.frame_count = out.blend_frames + motion_frames;
+  const size_t blend_frames = static_cast<size_t>(std::lround(std::max(0.0, o.blend_seconds) * o.fps));
+  // A motion shorter than the lead-in (a single pose) is held at its last frame until the lead-in ends.
+  const size_t motion_frames = std::max(static_cast<size_t>(std::floor(duration * o.fps + 1e-9)) + 1, blend_frames + 1);
+  out.frame_count = motion_frames;
   out.rotation.resize(out.frame_count * nt);
   out.position.resize(out.frame_count * nt);
 
@@ -230,10 +244,11 @@ BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions&
   const int body_hips = tgt.joint[kHips];
 
   for (size_t k = 0; k < motion_frames; ++k) {
-    const double frame = static_cast<double>(out.motion_first) + static_cast<double>(k) / o.fps / m.frame_time;
+    const double frame = std::min(static_cast<double>(out.motion_last),
+                                  static_cast<double>(out.motion_first) + static_cast<double>(k) / o.fps / m.frame_time);
     motion_world(m, frame, facing, sp, sg, lr, lt);
-    Quatf* w = out.rotation.data() + (out.blend_frames + k) * nt;
-    Vec3f* x = out.position.data() + (out.blend_frames + k) * nt;
+    Quatf* w = out.rotation.data() + k * nt;
+    Vec3f* x = out.position.data() + k * nt;
     for (size_t j : order) {
       const int pj = sk.joints[j].parent;
       const int c = canon_of[j];
@@ -249,6 +264,8 @@ BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions&
           const Vec3f want = sp[sn] - sp[sj];
           if (want.norm() > 1e-6f) w[j] = (swing(now, want) * w[j]).normalized();
         }
+        if ((c == kLArm || c == kRArm) && aim[static_cast<size_t>(c)] >= 0 && tgt.joint[kSpine1] >= 0)
+          keep_arm_off_torso(w[j], body_dir[static_cast<size_t>(c)], w[static_cast<size_t>(tgt.joint[kSpine1])], c == kLArm ? 1.0f : -1.0f);
       }
       if (static_cast<int>(j) == body_hips)
         x[j] = bind_p[j] + out.root_scale * (sp[src_hips] - hips_start);
@@ -257,19 +274,21 @@ BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions&
     }
   }
   motion_detail::place_on_floor(body, tgt, out);
-  // The lead-in: from the bind pose (where the garments were dressed) to the first frame.
+  // The lead-in: the motion plays from its first frame while its weight against the bind pose
+  // (where the garments were dressed) rises from 0 to 1 by smoothstep, so the body starts at rest
+  // and ends the lead-in at the motion's own velocities: no joint stops or starts in one frame.
+  out.blend_frames = std::min(blend_frames, out.frame_count);
   for (size_t k = 0; k < out.blend_frames; ++k) {
-    const float s = static_cast<float>(k) / static_cast<float>(out.blend_frames);
+    const float s = static_cast<float>(k) / static_cast<float>(blend_frames);
     const float a = s * s * (3 - 2 * s);
-    const Quatf* w1 = out.rotation.data() + out.blend_frames * nt;
-    const Vec3f* x1 = out.position.data() + out.blend_frames * nt;
     Quatf* w = out.rotation.data() + k * nt;
     Vec3f* x = out.position.data() + k * nt;
+    const std::vector<Vec3f> motion_x(x, x + nt);
     for (size_t j : order) {
       const int pj = sk.joints[j].parent;
-      w[j] = Quatf::Identity().slerp(a, w1[j]).normalized();
+      w[j] = Quatf::Identity().slerp(a, w[j]).normalized();
       if (static_cast<int>(j) == body_hips || pj < 0)
-        x[j] = (1 - a) * bind_p[j] + a * x1[j];
+        x[j] = (1 - a) * bind_p[j] + a * motion_x[j];
       else
         x[j] = x[pj] + w[pj] * (bind_p[j] - bind_p[static_cast<size_t>(pj)]);
     }

@@ -1,0 +1,96 @@
+#pragma once
+// Dressed bodies in motion (Vassilev & Spanlang sec. 5; Cordier et al.): the garments are dressed on
+// the body's bind pose (drape::dress), the motion is retargeted onto the body's rig, and the cloth
+// is simulated on the skinned body frame by frame, its collider following the skin at every solver
+// step (positions interpolated between frames, with the skin's velocity). See docs/animation.md.
+//
+//   AnimationResult r = animate(body, {{load_garment("shirt"), ""}}, read_motion("walk.bvh"), {});
+//   write_animation_outputs("out", body, r, {});   // anim.glb, frames.png, report.json, the frames
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "drape/dress.hpp"
+#include "drape/motion.hpp"
+
+namespace drape {
+
+struct AnimateOptions {
+  RetargetOptions retarget;                          // fps, frames, blend, calibration frame
+  Skinning skinning = Skinning::Linear;
+  DressOptions dress;                                // how the garments are dressed on the bind pose first
+  CollisionMethod collision = CollisionMethod::bvh;  // the moving body's collider
+  int substeps = 3;                                  // implicit solver steps per frame
+  // Coulomb coefficient between cloth and the moving skin; negative: the fabric's. 0 by default:
+  // with the fabric's friction the solver dragged the shirt into the walking body (docs/animation.md).
+  float friction = 0.0f;
+  // Gates every frame must pass (docs/animation.md): at most 1 % of the garment vertices inside the
+  // body, strain at most the fabric's threshold + 2 %, seams within 5 mm, nothing below the floor,
+  // no garment sliding off (its centre 15 cm lower against the hips than when dressed), no NaN.
+  QualityGates gates{0.005f, 0.01, 0.02f, 0.0f, 0.15f};
+};
+
+// One frame's measures: DESIGN.md's `quality` keys over all garments (settled: every solver step
+// of the frame converged; residual: the largest of the frame's last step) and the drop.
+struct AnimationFrame {
+  double time = 0;  // s
+  FitQuality quality;
+  int newton_iterations = 0;
+};
+
+struct AnimationProgress {
+  const char* phase = "";  // "dressing", "retargeting", "simulating"
+  size_t frame = 0, frames = 0;
+};
+using AnimationProgressCallback = std::function<void(const AnimationProgress&)>;
+
+struct AnimationResult {
+  BodyAnimation body;                      // the body's skeleton per frame
+  DressResult dressed;                     // the garments on the bind pose (frame 0)
+  // positions[g][f]: garment g's particles in frame f.
+  std::vector<std::vector<std::vector<Vec3f>>> positions;
+  std::vector<AnimationFrame> frames;
+  size_t worst_frame = 0;                  // most vertices inside the body, then the highest strain
+  FitQuality worst;                        // the worst of every key over the frames
+  std::vector<GateResult> gates;
+  StepStatus status = StepStatus::Ok;
+  double dress_seconds = 0, retarget_seconds = 0;
+  double simulation_seconds = 0;           // wall, the frames after the first (skinning, collider, cloth)
+  double skinning_seconds = 0, collider_seconds = 0, measure_seconds = 0;
+  ImplicitProfile profile;
+  double time_step = 0;                    // s, of the solver
+  bool passed() const { return all_passed(gates); }
+  double frames_per_wall_second() const;
+};
+
+// Dresses, retargets and simulates. InputError for bad garments, an unrigged body or a motion that
+// does not fit it (naming the file or joint).
+AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& garments, const Motion& motion,
+                        const AnimateOptions& options = {}, const AnimationProgressCallback& progress = {});
+
+// The body's vertices in every frame (frames x vertices), skinned as the simulation saw them.
+std::vector<std::vector<Vec3f>> skinned_frames(const Body& body, const BodyAnimation& animation, Skinning method);
+
+// anim.glb's scene: node `body` skinned, its joints animated (rotations; the root's translation),
+// then one node per garment whose frames are morph targets with a weight animation (frame f: the
+// f-th target at weight 1, linear in between).
+Scene animation_scene(const Body& body, const AnimationResult& result);
+// report.json: `frames` (DESIGN.md's quality keys per frame), `worst_frame`, `quality` (the worst
+// over the frames), `simulation` (frames, wall_seconds, frames_per_wall_second, ...), the gates,
+// and what retargeting did.
+std::string animation_report_json(const Motion& motion, const AnimationResult& result, const AnimateOptions& options);
+
+struct AnimationOutputOptions {
+  int video_width = 640, video_height = 360;  // front and side views per frame
+  bool video = true;                          // anim.mp4 (ffmpeg on the PATH) or frames/frame_NNNN.png
+};
+// Writes anim.glb, frames.png (a contact sheet of up to 12 frames), report.json and the video
+// (anim.mp4 when ffmpeg is found, else frames/frame_NNNN.png) into `dir`, each file atomically.
+// Returns the video's path (empty without one).
+std::filesystem::path write_animation_outputs(const std::filesystem::path& dir, const Body& body, const Motion& motion,
+                                              const AnimationResult& result, const AnimateOptions& options,
+                                              const AnimationOutputOptions& output = {});
+
+}  // namespace drape

@@ -61,7 +61,7 @@ void run_fit(const FitArgs& a) {
                  t.verdict.c_str());
     std::string pattern;
     for (const RegionFit& r : t.pattern)
-      pattern += fmt::format("{}{} {:+.1f} cm ({})", pattern.empty() ? "" : ", ", r.region, 100 * r.ease_m, to_string(r.verdict));
+      if (r.girth) pattern += fmt::format("{}{} {:+.1f} cm ({})", pattern.empty() ? "" : ", ", r.region, 100 * r.ease_m, to_string(r.verdict));
     if (!pattern.empty()) std::fprintf(stderr, "     on the pattern, before draping: %s\n", pattern.c_str());
   }
   if (advice.has_recommendation()) std::fprintf(stderr, "\n%s", fit_table(advice.sizes[advice.recommended].fit).c_str());

@@ -180,11 +180,12 @@ struct FitAnalysis {
 FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, const Collider& body_collider,
                         const FitThresholds& thresholds = {});
 
-// The garment's girths at the body's girth lines measured on its pattern before draping: `placed`
-// is the garment as placement put it round the body (seams still open), and each line cuts the
-// panels where they lie; ease = pattern girth - body girth, judged tight / good / loose as above
-// (no peaks, no open-seam test: every seam is open before sewing).
-std::vector<RegionFit> pattern_girths(const Body& body, const FitGarment& placed, const FitThresholds& thresholds = {});
+// The garment measured on its pattern before draping: `placed` is the garment as placement put it
+// round the body (seams still open). Each girth line cuts the panels where they lie (ease =
+// pattern girth - body girth, judged tight / good / loose as above; no peaks, no open-seam test:
+// every seam is open before sewing), and the sleeve, leg and garment lengths are taken as placed.
+std::vector<RegionFit> pattern_measurements(const Body& body, const FitGarment& placed,
+                                            const FitThresholds& thresholds = {});
 
 // report.json's `fit` object (per garment: regions with verdict, ease, peak strain and pressure;
 // totals) and a table for the terminal.

@@ -29,7 +29,8 @@ struct SizeTrial {
   Garment garment;   // the size's pattern
   DressResult result;
   FitAnalysis fit;
-  // Girths on the pattern before draping: the panels placed round the body, cut at its lines.
+  // Measured on the pattern before draping: the panels placed round the body, cut at its girth
+  // lines; lengths as placed (pattern_measurements).
   std::vector<RegionFit> pattern;
   bool closes = false;    // every seam closed (and the simulation stayed finite)
   bool stays_on = false;  // the garment did not slide off

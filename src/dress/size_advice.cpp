@@ -158,7 +158,7 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
     const auto placement_collider = make_body_collider(body.mesh, options.collision);
     for (SizeTrial& t : advice.sizes) {
       const DressedGarment placed = prepare_garment(body, t.garment, *placement_collider, options);
-      t.pattern = pattern_girths(body, fit_garment(placed, t.garment));
+      t.pattern = pattern_measurements(body, fit_garment(placed, t.garment));
     }
   }
   const auto count = static_cast<int>(advice.sizes.size());
@@ -267,9 +267,14 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
     nlohmann::ordered_json fit = nlohmann::ordered_json::parse(fit_json(t.fit));
     nlohmann::ordered_json regions = fit["garments"].empty() ? nlohmann::ordered_json::array() : fit["garments"][0]["regions"];
     nlohmann::ordered_json pattern = nlohmann::ordered_json::array();
-    for (const RegionFit& r : t.pattern)
-      pattern.push_back({{"region", r.region}, {"verdict", std::string(to_string(r.verdict))}, {"ease_cm", 100.0 * r.ease_m},
-                         {"garment_girth_m", r.garment_m}, {"body_girth_m", r.body_m}});
+    for (const RegionFit& r : t.pattern) {
+      if (r.girth)
+        pattern.push_back({{"region", r.region}, {"verdict", std::string(to_string(r.verdict))}, {"ease_cm", 100.0 * r.ease_m},
+                           {"garment_girth_m", r.garment_m}, {"body_girth_m", r.body_m}});
+      else
+        pattern.push_back({{"region", r.region}, {"verdict", std::string(to_string(r.verdict))},
+                           {"garment_length_m", r.garment_m}, {"body_length_m", r.body_m}, {"reason", r.reason}});
+    }
     sizes.push_back({{"size", t.size},
                      {"recommended", k == advice.recommended},
                      {"verdict", t.verdict},
@@ -277,7 +282,7 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
                      {"stays_on", t.stays_on},
                      {"chart_distance", t.chart_distance >= 0 ? nlohmann::ordered_json(t.chart_distance) : nlohmann::ordered_json(nullptr)},
                      {"regions", regions},
-                     {"pattern_girths", pattern},
+                     {"pattern", pattern},
                      {"fit", fit},
                      {"gates", {{"passed", failed.empty()}, {"failed", failed}, {"checks", gates}}},
                      {"max_strain", t.result.quality.max_strain},

@@ -167,6 +167,76 @@ std::optional<GirthCut> cut_at_line(const body::Slicer& slicer, const FitGarment
   }
   return out;
 }
+
+// Sleeve, leg and garment lengths of a garment where it lies (`regions` already has its girth
+// lines: a garment with a thighs line has legs).
+void add_lengths(const Body& body, const FitGarment& in, std::vector<RegionFit>& regions) {
+  const Landmarks& lm = body.landmarks;
+  const Measurements& m = body.measurements;
+    const Vec3f wrist_axis = (lm.left_wrist - lm.left_shoulder).normalized();
+    float sleeve = -1;
+    bool any_arm = false;
+    for (size_t i = 0; i < in.x.size(); ++i)
+      if (!in.on_arm.empty() && in.on_arm[i] && in.x[i].x() > 0) {
+        any_arm = true;
+        sleeve = std::max(sleeve, (in.x[i] - lm.left_shoulder).dot(wrist_axis));
+      }
+    if (any_arm && m.arm_length > 0) {
+      RegionFit r;
+      r.region = "sleeve_length";
+      r.body_m = m.arm_length;
+      r.garment_m = sleeve;
+      r.ease_m = sleeve - m.arm_length;
+      const float hand = (lm.left_fingertip - lm.left_shoulder).dot(wrist_axis);
+      r.verdict = sleeve > hand ? FitVerdict::long_ : FitVerdict::good;
+      r.reason = sleeve > hand ? fmt::format("sleeves are long: they cover the hand ({} past the wrist)", cm(r.ease_m))
+                 : r.ease_m >= 0 ? fmt::format("sleeves end {} past the wrist", cm(r.ease_m))
+                                 : fmt::format("sleeves end {} above the wrist", cm(-r.ease_m));
+      regions.push_back(std::move(r));
+    }
+    float top = -1e9f, bottom = 1e9f, leg_bottom = 1e9f;
+    for (const Vec3f& p : in.x) {
+      top = std::max(top, p.y());
+      bottom = std::min(bottom, p.y());
+    }
+    const bool legged = std::any_of(regions.begin(), regions.end(), [](const RegionFit& r) { return r.region == "thighs"; });
+    if (legged) {
+      for (const Vec3f& p : in.x)
+        if (p.x() > 0 && p.y() < lm.crotch.y()) leg_bottom = std::min(leg_bottom, p.y());
+      RegionFit r;
+      r.region = "leg_length";
+      r.body_m = m.inseam;
+      r.garment_m = lm.crotch.y() - leg_bottom;
+      r.ease_m = r.garment_m - m.inseam;
+      r.verdict = leg_bottom < 0.01f ? FitVerdict::long_ : FitVerdict::good;
+      r.reason = leg_bottom < 0.01f ? std::string("legs are long: the hems lie on the floor")
+                                    : fmt::format("legs end {} above the floor", cm(leg_bottom));
+      regions.push_back(std::move(r));
+    }
+    if (top > bottom) {
+      RegionFit r;
+      r.region = "garment_length";
+      r.garment_m = top - bottom;
+      r.body_m = m.height;
+      r.ease_m = 0;
+      // Where the hem ends, by the nearest landmark at or below it.
+      const std::array<std::pair<const char*, float>, 6> marks{{{"the waist", lm.waist.y()},
+                                                                 {"the hips", lm.hip.y()},
+                                                                 {"the crotch", lm.crotch.y()},
+                                                                 {"the knee", lm.left_knee.y()},
+                                                                 {"the ankle", lm.left_ankle.y()},
+                                                                 {"the floor", 0.0f}}};
+      const auto& mark = *std::min_element(marks.begin(), marks.end(), [&](const auto& a, const auto& b) {
+        return std::abs(a.second - bottom) < std::abs(b.second - bottom);
+      });
+      const float off = bottom - mark.second;
+      r.verdict = bottom < 0.01f ? FitVerdict::long_ : FitVerdict::good;
+      r.reason = r.verdict == FitVerdict::long_ ? std::string("long: the garment lies on the floor")
+                 : fmt::format("{} long, the hem {} {} {}", cm(r.garment_m), cm(std::abs(off)),
+                               off >= 0 ? "above" : "below", mark.first);
+      regions.push_back(std::move(r));
+    }
+}
 }  // namespace
 
 std::vector<const RegionFit*> FitAnalysis::worst_first() const {
@@ -305,82 +375,18 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
       g.regions.push_back(std::move(r));
     }
 
-    // Lengths.
-    {
-      const Vec3f wrist_axis = (lm.left_wrist - lm.left_shoulder).normalized();
-      float sleeve = -1;
-      bool any_arm = false;
-      for (size_t i = 0; i < in.x.size(); ++i)
-        if (!in.on_arm.empty() && in.on_arm[i] && in.x[i].x() > 0) {
-          any_arm = true;
-          sleeve = std::max(sleeve, (in.x[i] - lm.left_shoulder).dot(wrist_axis));
-        }
-      if (any_arm && m.arm_length > 0) {
-        RegionFit r;
-        r.region = "sleeve_length";
-        r.body_m = m.arm_length;
-        r.garment_m = sleeve;
-        r.ease_m = sleeve - m.arm_length;
-        const float hand = (lm.left_fingertip - lm.left_shoulder).dot(wrist_axis);
-        r.verdict = sleeve > hand ? FitVerdict::long_ : FitVerdict::good;
-        r.reason = sleeve > hand ? fmt::format("sleeves are long: they cover the hand ({} past the wrist)", cm(r.ease_m))
-                   : r.ease_m >= 0 ? fmt::format("sleeves end {} past the wrist", cm(r.ease_m))
-                                   : fmt::format("sleeves end {} above the wrist", cm(-r.ease_m));
-        g.regions.push_back(std::move(r));
-      }
-      float top = -1e9f, bottom = 1e9f, leg_bottom = 1e9f;
-      for (const Vec3f& p : in.x) {
-        top = std::max(top, p.y());
-        bottom = std::min(bottom, p.y());
-      }
-      const bool legged = std::any_of(g.regions.begin(), g.regions.end(), [](const RegionFit& r) { return r.region == "thighs"; });
-      if (legged) {
-        for (const Vec3f& p : in.x)
-          if (p.x() > 0 && p.y() < lm.crotch.y()) leg_bottom = std::min(leg_bottom, p.y());
-        RegionFit r;
-        r.region = "leg_length";
-        r.body_m = m.inseam;
-        r.garment_m = lm.crotch.y() - leg_bottom;
-        r.ease_m = r.garment_m - m.inseam;
-        r.verdict = leg_bottom < 0.01f ? FitVerdict::long_ : FitVerdict::good;
-        r.reason = leg_bottom < 0.01f ? std::string("legs are long: the hems lie on the floor")
-                                      : fmt::format("legs end {} above the floor", cm(leg_bottom));
-        g.regions.push_back(std::move(r));
-      }
-      if (top > bottom) {
-        RegionFit r;
-        r.region = "garment_length";
-        r.garment_m = top - bottom;
-        r.body_m = m.height;
-        r.ease_m = 0;
-        // Where the hem ends, by the nearest landmark at or below it.
-        const std::array<std::pair<const char*, float>, 6> marks{{{"the waist", lm.waist.y()},
-                                                                   {"the hips", lm.hip.y()},
-                                                                   {"the crotch", lm.crotch.y()},
-                                                                   {"the knee", lm.left_knee.y()},
-                                                                   {"the ankle", lm.left_ankle.y()},
-                                                                   {"the floor", 0.0f}}};
-        const auto& mark = *std::min_element(marks.begin(), marks.end(), [&](const auto& a, const auto& b) {
-          return std::abs(a.second - bottom) < std::abs(b.second - bottom);
-        });
-        const float off = bottom - mark.second;
-        r.verdict = bottom < 0.01f ? FitVerdict::long_ : FitVerdict::good;
-        r.reason = r.verdict == FitVerdict::long_ ? std::string("long: the garment lies on the floor")
-                   : fmt::format("{} long, the hem {} {} {}", cm(r.garment_m), cm(std::abs(off)),
-                                 off >= 0 ? "above" : "below", mark.first);
-        g.regions.push_back(std::move(r));
-      }
-    }
+    add_lengths(body, in, g.regions);
   }
   return fit;
 }
 
-std::vector<RegionFit> pattern_girths(const Body& body, const FitGarment& placed, const FitThresholds& thresholds) {
+std::vector<RegionFit> pattern_measurements(const Body& body, const FitGarment& placed, const FitThresholds& thresholds) {
   std::vector<RegionFit> out;
   const body::Slicer slicer(body.mesh);
   for (const Line& line : girth_lines(body, slicer))
     if (auto cut = cut_at_line(slicer, placed, line, thresholds, placed.model->fabric.strain_threshold, false))
       out.push_back(std::move(cut->region));
+  add_lengths(body, placed, out);
   return out;
 }
 

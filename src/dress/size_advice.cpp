@@ -46,48 +46,73 @@ double chart_distance(const SizeMeasurements& entry, const Measurements& body) {
   return n == 0 ? -1.0 : std::sqrt(sum / static_cast<double>(n));
 }
 
-// One line: why this size does or does not fit.
-std::string size_verdict(const SizeTrial& t) {
-  if (!gate_passed(t.result.gates, "finite")) return "the simulation failed (non-finite positions)";
-  if (!t.closes) {
-    for (const DressedGarment& g : t.result.garments) {
-      const size_t seam = g.widest_seam();
-      if (seam < g.seam_names.size())
-        return fmt::format("does not close: seam '{}' stays {:.0f} mm open", g.seam_names[seam], 1e3f * g.seam_gaps()[seam]);
-    }
-    return "does not close";
-  }
-  if (!t.stays_on) return fmt::format("slides off: it fell {:.2f} m", static_cast<double>(t.result.quality.drop_m));
-  std::vector<std::string> parts;
+// What the fit per region found wrong: tight or loose girth lines (`girths`), tight zones, lengths
+// that are too long (`others`).
+void fit_issues(const SizeTrial& t, std::vector<std::string>* girths, std::vector<std::string>* others) {
   for (const GarmentFit& g : t.fit.garments)
     for (const RegionFit& r : g.regions) {
-      if (r.verdict == FitVerdict::tight) {
-        if (r.girth)
-          parts.push_back(fmt::format("tight at the {} (ease {:+.1f} cm, stretched {:.1f} %, limit {:.0f} %)", r.region,
-                                      100 * r.ease_m, 100 * r.hoop_strain, 100 * g.strain_limit));
-        else
-          parts.push_back(fmt::format("tight at the {} ({:.0f} % of the limit)", r.region, r.peak_strain_percent));
-      } else if (r.verdict == FitVerdict::loose) {
-        parts.push_back(fmt::format("loose at the {} (ease {:+.1f} cm)", r.region, 100 * r.ease_m));
-      } else if (r.verdict == FitVerdict::long_) {
-        parts.push_back(r.reason);
+      if (r.verdict == FitVerdict::tight && r.girth && girths) {
+        girths->push_back(r.open_seam_m > 0
+                              ? fmt::format("tight at the {} (a seam {:.0f} mm open there)", r.region, 1e3f * r.open_seam_m)
+                              : fmt::format("tight at the {} (ease {:+.1f} cm, stretched {:.1f} %, limit {:.0f} %)", r.region,
+                                            100 * r.ease_m, 100 * r.hoop_strain, 100 * g.strain_limit));
+      } else if (r.verdict == FitVerdict::loose && girths) {
+        girths->push_back(fmt::format("loose at the {} (ease {:+.1f} cm)", r.region, 100 * r.ease_m));
+      } else if (r.verdict == FitVerdict::tight && !r.girth && others) {
+        others->push_back(fmt::format("tight at the {} ({:.0f} % of the limit)", r.region, r.peak_strain_percent));
+      } else if (r.verdict == FitVerdict::long_ && others) {
+        others->push_back(r.reason);
       }
     }
-  for (const GateResult& g : t.result.gates)
-    if (!g.passed) parts.push_back(g.name == "settled" ? std::string("still moving when the run stopped") : g.detail);
-  if (parts.empty()) return "fits";
+  if (others)
+    for (const GateResult& g : t.result.gates)
+      if (!g.passed && g.name != "seams_closed" && g.name != "stayed_on" && g.name != "finite")
+        others->push_back(g.name == "settled" ? std::string("still moving when the run stopped") : g.detail);
+}
+
+std::string join(const std::vector<std::string>& parts) {
   std::string s;
   for (const std::string& p : parts) s += (s.empty() ? "" : "; ") + p;
   return s;
 }
 
-// "waist ease 2.1 cm, hips 4.0 cm"
-std::string ease_summary(const FitAnalysis& fit) {
+// One line: why this size does or does not fit.
+std::string size_verdict(const SizeTrial& t) {
+  if (!gate_passed(t.result.gates, "finite")) return "the simulation failed (non-finite positions)";
+  std::vector<std::string> girths, others;
+  if (!t.closes) {
+    std::string s = "does not close";
+    for (const DressedGarment& g : t.result.garments) {
+      const size_t seam = g.widest_seam();
+      if (seam < g.seam_names.size()) {
+        s = fmt::format("does not close: seam '{}' stays {:.0f} mm open", g.seam_names[seam], 1e3f * g.seam_gaps()[seam]);
+        break;
+      }
+    }
+    fit_issues(t, &girths, nullptr);
+    girths.erase(std::remove_if(girths.begin(), girths.end(), [](const std::string& p) { return p.rfind("tight", 0) != 0; }),
+                 girths.end());
+    return girths.empty() ? s : s + "; " + join(girths);
+  }
+  if (!t.stays_on) return fmt::format("slides off: it fell {:.2f} m", static_cast<double>(t.result.quality.drop_m));
+  fit_issues(t, &girths, &others);
+  girths.insert(girths.end(), others.begin(), others.end());
+  return girths.empty() ? std::string("fits") : join(girths);
+}
+
+// "hips ease +1.3 cm, thighs ease +16.6 cm (loose)", then what else was found (a tight zone, a
+// failed gate).
+std::string ease_summary(const SizeTrial& t) {
   std::string s;
-  for (const GarmentFit& g : fit.garments)
+  for (const GarmentFit& g : t.fit.garments)
     for (const RegionFit& r : g.regions)
-      if (r.girth) s += fmt::format("{}{} ease {:+.1f} cm", s.empty() ? "" : ", ", r.region, 100 * r.ease_m);
-  return s.empty() ? std::string("no girth line covered") : s;
+      if (r.girth)
+        s += fmt::format("{}{} ease {:+.1f} cm{}", s.empty() ? "" : ", ", r.region, 100 * r.ease_m,
+                         r.verdict == FitVerdict::good ? std::string() : fmt::format(" ({})", to_string(r.verdict)));
+  if (s.empty()) s = "no girth line covered";
+  std::vector<std::string> others;
+  fit_issues(t, nullptr, &others);
+  return others.empty() ? s : s + "; " + join(others);
 }
 
 }  // namespace
@@ -232,15 +257,14 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
 
   if (advice.has_recommendation()) {
     const SizeTrial& r = advice.sizes[advice.recommended];
-    advice.reasons.push_back(fmt::format("{}: recommended ({}): {}{}", r.size, advice.rule, ease_summary(r.fit),
-                                         r.verdict == "fits" ? std::string() : "; " + r.verdict));
+    advice.reasons.push_back(fmt::format("{}: recommended ({}): {}", r.size, advice.rule, ease_summary(r)));
   } else {
     advice.reasons.push_back("no size is recommended: none closes and stays on the body");
   }
   for (size_t k = 0; k < advice.sizes.size(); ++k) {
     const SizeTrial& t = advice.sizes[k];
     if (k == advice.recommended) continue;
-    advice.reasons.push_back(t.closes && t.stays_on ? fmt::format("{}: {}; {}", t.size, t.verdict, ease_summary(t.fit))
+    advice.reasons.push_back(t.closes && t.stays_on ? fmt::format("{}: {}", t.size, ease_summary(t))
                                                     : fmt::format("{}: {}", t.size, t.verdict));
   }
   return advice;

@@ -109,7 +109,8 @@ void run_animate(const AnimateArgs& a) {
 
   const BodyAnimation& b = r.body;
   std::fprintf(stderr,
-               "%s -> %s skeleton (%s); %zu frames at %.0f fps (%zu lead-in), root scale %.4f, feet: lowest %.1f mm, "
+               "%s -> %s skeleton (%s); %zu frames at %.0f fps (the first %zu blended from the dressed pose), root scale %.4f, "
+               "feet: lowest %.1f mm, "
                "sliding %.2f m\n",
                b.motion_convention.c_str(), b.body_convention.c_str(), b.skipped_calibration ? "calibration frame skipped" : "no calibration frame",
                b.frame_count, 1.0 / b.frame_time, b.blend_frames, static_cast<double>(b.root_scale), 1e3 * static_cast<double>(b.feet.lowest_y),

@@ -262,8 +262,6 @@ FitAnalysis analyse_fit(const Body& body, std::span<const FitGarment> garments, 
   FitAnalysis fit;
   fit.pressure = empty_pressure_map(body.mesh);
   const Landmarks& lm = body.landmarks;
-  const Measurements& m = body.measurements;
-  const Vec3f up = Vec3f::UnitY();
   const Vec3f gravity(0.0f, -9.81f, 0.0f);
 
   // A garment whose simulation went non-finite has no fit to measure.

@@ -229,7 +229,7 @@ BodyAnimation retarget(const Motion& m, const Body& body, const RetargetOptions&
   const double duration = static_cast<double>(out.motion_last - out.motion_first) * m.frame_time;
   const size_t blend_frames = static_cast<size_t>(std::lround(std::max(0.0, o.blend_seconds) * o.fps));
   // A motion shorter than the lead-in (a single pose) is held at its last frame until the lead-in ends.
-  const size_t motion_frames = std::max(static_cast<size_t>(std::floor(duration * o.fps + 1e-9)) + 1, blend_frames + 1);
+  const size_t motion_frames = std::max(static_cast<size_t>(std::floor(duration * o.fps + 1e-3)) + 1, blend_frames + 1);
   out.frame_count = motion_frames;
   out.rotation.resize(out.frame_count * nt);
   out.position.resize(out.frame_count * nt);

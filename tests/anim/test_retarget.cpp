@@ -11,7 +11,9 @@
 #include <regex>
 #include <sstream>
 
+#include "drape/animate.hpp"
 #include "drape/body.hpp"
+#include "drape/io.hpp"
 #include "drape/error.hpp"
 #include "drape/motion.hpp"
 #include "support/test_support.hpp"
@@ -242,6 +244,45 @@ TEST(Skinning, SameResultOnAnyThreadCount) {
     ASSERT_TRUE(one == two);
   }
   omp_set_num_threads(threads);
+}
+
+}  // namespace
+}  // namespace drape
+
+namespace drape {
+namespace {
+
+// anim.glb's joint animation read back as a motion (glTF input) and retargeted onto the same body
+// gives the same joint positions: the writer's local rotations and the glTF motion reader agree.
+TEST(GltfMotion, AnimationRoundTripsThroughGlb) {
+  const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
+  const Body& body = rig_body_of(RigBody::DefaultFemale);
+  RetargetOptions o;
+  o.last_frame = 120;
+  AnimationResult r;
+  r.body = retarget(read_motion(path), body, o);
+  r.frames.resize(r.body.frame_count);
+  const auto dir = test::temp_dir("gltf_motion");
+  write_scene(dir / "walk.glb", animation_scene(body, r));
+  const Motion m = read_motion(dir / "walk.glb");
+  EXPECT_EQ(m.format, "gltf");
+  EXPECT_EQ(m.frame_count, r.body.frame_count);
+  RetargetOptions again;
+  again.blend_seconds = 0;
+  const BodyAnimation b = retarget(m, body, again);
+  ASSERT_EQ(b.frame_count, r.body.frame_count);
+  EXPECT_EQ(b.motion_convention, "drape");
+  // The pose of every frame (joints against the hips) comes back within 1 mm; the clip as a whole may
+  // sit differently on the floor, as the floor is fitted again to the clip read back (within 1.5 cm).
+  float worst_pose = 0, worst_root = 0;
+  for (size_t f = 0; f < b.frame_count; ++f) {
+    const Vec3f root_b = b.pose(f).position[0], root_a = r.body.pose(f).position[0];
+    worst_root = std::max(worst_root, (root_b - root_a).norm());
+    for (size_t j = 0; j < b.joint_count; ++j)
+      worst_pose = std::max(worst_pose, ((b.pose(f).position[j] - root_b) - (r.body.pose(f).position[j] - root_a)).norm());
+  }
+  EXPECT_LT(worst_pose, 0.001f);
+  EXPECT_LT(worst_root, 0.015f);
 }
 
 }  // namespace

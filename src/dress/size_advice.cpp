@@ -48,7 +48,7 @@ double chart_distance(const SizeMeasurements& entry, const Measurements& body) {
 
 // What the fit per region found wrong: tight or loose girth lines (`girths`), tight zones, lengths
 // that are too long (`others`).
-void fit_issues(const SizeTrial& t, std::vector<std::string>* girths, std::vector<std::string>* others) {
+void fit_problems(const SizeTrial& t, std::vector<std::string>* girths, std::vector<std::string>* others) {
   for (const GarmentFit& g : t.fit.garments)
     for (const RegionFit& r : g.regions) {
       if (r.verdict == FitVerdict::tight && r.girth && girths) {
@@ -89,13 +89,13 @@ std::string size_verdict(const SizeTrial& t) {
         break;
       }
     }
-    fit_issues(t, &girths, nullptr);
+    fit_problems(t, &girths, nullptr);
     girths.erase(std::remove_if(girths.begin(), girths.end(), [](const std::string& p) { return p.rfind("tight", 0) != 0; }),
                  girths.end());
     return girths.empty() ? s : s + "; " + join(girths);
   }
   if (!t.stays_on) return fmt::format("slides off: it fell {:.2f} m", static_cast<double>(t.result.quality.drop_m));
-  fit_issues(t, &girths, &others);
+  fit_problems(t, &girths, &others);
   girths.insert(girths.end(), others.begin(), others.end());
   return girths.empty() ? std::string("fits") : join(girths);
 }
@@ -111,7 +111,7 @@ std::string ease_summary(const SizeTrial& t) {
                          r.verdict == FitVerdict::good ? std::string() : fmt::format(" ({})", to_string(r.verdict)));
   if (s.empty()) s = "no girth line covered";
   std::vector<std::string> others;
-  fit_issues(t, nullptr, &others);
+  fit_problems(t, nullptr, &others);
   return others.empty() ? s : s + "; " + join(others);
 }
 

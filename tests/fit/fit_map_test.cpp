@@ -32,8 +32,8 @@ TEST(FitStrain, TriangleStretchedAlongTheWarp) {
 
 TEST(FitStrain, ShearStretchesOnlyTheBias) {
   const Vec2f a(0, 0), b(0.02f, 0), c(0, 0.02f);
-  // Simple shear: warp and weft fibres keep their length (c moves along x while staying 2 cm from a
-  // only approximately, so shear by rotating the warp fibre instead).
+  // Shear: the warp fibre a-c turns by 0.1 rad towards the weft, keeping its length, as does the
+  // weft fibre a-b; only the diagonals change length.
   const float angle = 0.1f;
   const Vec3f pc(0.02f * std::sin(angle), 0.02f * std::cos(angle), 0);
   const auto s = directional_strain(a, b, c, Vec3f(0, 0, 0), Vec3f(0.02f, 0, 0), pc, Vec2f::UnitY());

@@ -437,9 +437,11 @@ std::string fit_table(const FitAnalysis& fit) {
     s += fmt::format("fit of {} {} (strain limit {:.0f} %):\n", g.name, g.size, 100 * g.strain_limit);
     s += fmt::format("  {:<15} {:<7} {:>9} {:>12} {:>14}\n", "region", "verdict", "ease", "peak strain", "peak pressure");
     for (const RegionFit& r : g.regions) {
+      // Girths and sleeve / leg lengths: ease; the garment's length: itself; zones: nothing.
       const std::string ease = r.girth || r.region == "sleeve_length" || r.region == "leg_length"
                                    ? fmt::format("{:+.1f} cm", 100 * r.ease_m)
-                                   : fmt::format("{:.0f} cm", 100 * r.garment_m);
+                               : r.region == "garment_length" ? fmt::format("{:.0f} cm", 100 * r.garment_m)
+                                                              : std::string("-");
       s += fmt::format("  {:<15} {:<7} {:>9} {:>10.0f} % {:>9.0f} N/m2\n", r.region, to_string(r.verdict), ease,
                        r.peak_strain_percent, r.peak_pressure_pa);
     }

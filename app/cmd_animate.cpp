@@ -151,7 +151,7 @@ void add_animate_command(CLI::App& app) {
   cmd->add_option("--fps", args->fps, "frames per second of the animation (the motion is resampled)")
       ->capture_default_str()->check(CLI::Range(1.0, 240.0));
   cmd->add_option("--frames", args->frames, "FIRST:LAST motion frames to use (after a skipped calibration frame), e.g. 0:240 or 30:");
-  cmd->add_option("--blend", args->blend, "seconds of lead-in from the dressed pose to the motion's first frame")
+  cmd->add_option("--blend", args->blend, "seconds of lead-in: the motion plays from its first frame while its weight against the dressed pose rises from 0 to 1")
       ->capture_default_str()->check(CLI::Range(0.0, 5.0));
   cmd->add_flag("--keep-first-frame", args->keep_first_frame, "use a calibration T-pose in the motion's first frame as a frame");
   cmd->add_option("--skinning", args->skinning, "linear (blend skinning) or dq (dual quaternion)")

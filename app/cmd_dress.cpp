@@ -138,10 +138,21 @@ void run_dress(const DressArgs& a) {
   if (!result.passed()) {
     for (const GateResult& g : result.gates)
       if (!g.passed) std::fprintf(stderr, "drape: dress: gate %s failed: %s\n", g.name.c_str(), g.detail.c_str());
-    // A seam that sewing could no longer close: name it, and say what that usually means.
+    // A seam that sewing could no longer close: name it, and say what that usually means (the
+    // implicit solver sews and drapes to equilibrium: a seam open there, unless the run was capped,
+    // is held open by the body).
     for (const DressedGarment& g : result.garments) {
       const size_t seam = g.widest_seam();
-      if (!g.sewing_stalled || seam >= g.seam_names.size() || g.seam_gaps()[seam] <= o.seam_closed_m) continue;
+      if (seam >= g.seam_names.size() || g.seam_gaps()[seam] <= o.gates.max_seam_gap_m) continue;
+      if (o.solver == Solver::Implicit) {
+        if (o.max_iterations && g.state.iterations >= o.max_iterations) continue;
+        std::fprintf(stderr,
+                     "drape: dress: %s %s: seam '%s' stays %.1f mm open: the body holds it apart; a larger size "
+                     "may fit\n",
+                     g.name.c_str(), g.size.c_str(), g.seam_names[seam].c_str(), 1000.0 * g.seam_gaps()[seam]);
+        continue;
+      }
+      if (!g.sewing_stalled || g.seam_gaps()[seam] <= o.seam_closed_m) continue;
       std::fprintf(stderr,
                    "drape: dress: %s %s: sewing stopped after %llu iterations with seam '%s' open: the cloth "
                    "around it was held at its stretch limit by the body; a larger size may fit\n",
@@ -153,6 +164,9 @@ void run_dress(const DressArgs& a) {
 }
 
 }  // namespace
+
+// Settings only the explicit step uses: listed under their own heading in --help.
+constexpr const char* kExplicitGroup = "Explicit solver (--solver explicit)";
 
 void add_dress_command(CLI::App& app) {
   auto args = std::make_shared<DressArgs>();
@@ -169,8 +183,9 @@ void add_dress_command(CLI::App& app) {
                   "entry is nearest to the body's measurements (docs/garment-format.md), report.json says why");
   cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own");
   cmd->add_option("--solver", args->solver,
-                  "implicit (Newton on the incremental potential, quasi-static steps to equilibrium) or explicit "
-                  "(the paper's explicit Euler with velocity modification, sec. 3.3)")
+                  "implicit (Newton on the incremental potential: quasi-static steps to equilibrium, the strain "
+                  "limit, contact and friction inside the solve) or explicit (the paper's explicit Euler with "
+                  "velocity modification, sec. 3.3, with the settings under its own heading below)")
       ->capture_default_str()->check(CLI::IsMember({"implicit", "explicit"}));
   cmd->add_option("--collision", args->collision, "body collision: image (paper sec. 4.2), bvh (sec. 4.1) or sdf")
       ->capture_default_str()->check(CLI::IsMember({"image", "bvh", "sdf"}));
@@ -189,23 +204,27 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--mass-scaling", args->mass_scaling,
                   "particles whose stability bound is below this fraction of the median particle's get more inertia "
                   "(weight unchanged), for a longer time step; the state of rest is the same (0: off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kExplicitGroup);
   cmd->add_option("--sewing-stall", args->sewing_stall,
                   "stop sewing when for this many seconds of simulated time no seam pair was joined and the widest "
                   "open pair (over 15 mm) closed by less than 1 mm: the body holds it open, usually a size too small; "
                   "draping then starts with the seam springs still pulling (0: sew to the 1.5 s cap)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kExplicitGroup);
   cmd->add_option("--pull-closed", args->pull_closed,
                   "when sewing ends, pull the seam pairs still open by at most this many metres closed and join them, "
                   "as a sewer closes the last stitches (the paper's seaming after a number of iterations); wider "
                   "pairs are left to the seam springs and reported (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kExplicitGroup);
   cmd->add_option("--face-clearance", args->face_clearance,
                   "while draping, keep the cloth's faces, not only its vertices, this many metres off the body where "
                   "it curves under them (the particles are lifted by at most 6 mm; above the fabric's 4 mm "
                   "collision thickness every particle in contact is lifted by the difference), so the skin does "
                   "not show through a coarse mesh; negative: off")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->group(kExplicitGroup);
   cmd->add_flag("--placement-only", args->placement_only,
                 "write the garments where placement put them, before sewing (fails the settled gate)");
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();

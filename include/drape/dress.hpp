@@ -32,8 +32,10 @@ inline constexpr double kPaperEdgeLength = 0.026;
 
 struct DressOptions {
   // implicit: Newton on the incremental potential, quasi-static steps to equilibrium (drape/implicit.hpp);
-  // explicit: the paper's explicit Euler with velocity modification, and the settings below it uses.
-  Solver solver = Solver::Explicit;
+  // explicit: the paper's explicit Euler with velocity modification (sec. 3.3), and the settings
+  // below that say they are its own (sewing stall, pulled-closed stitches, draping time and damping,
+  // strain passes, time step, projection, mass scaling, face clearance).
+  Solver solver = Solver::Implicit;
   CollisionMethod collision = CollisionMethod::image;
   MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
   std::string fabric;  // empty: each garment's own

@@ -46,9 +46,11 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
     EXPECT_TRUE(report["simulation"].contains(k)) << k;
   EXPECT_EQ(report["gates"]["passed"].get<bool>(), r.exit_code == 0);
   EXPECT_EQ(report["garments"][0]["name"], "shirt");
-  // Draping with selective mass scaling (on by default): the outline's light particles were scaled.
-  EXPECT_GT(report["garments"][0]["mass_scaled_particles"].get<int>(), 0);
-  EXPECT_GT(report["garments"][0]["strain_passes_per_iteration"].get<double>(), 0.0);
+  // The implicit solver (the default): Newton iterations and factorisations, and equilibrium.
+  EXPECT_EQ(report["settings"]["solver"], "implicit");
+  EXPECT_GT(report["garments"][0]["newton_iterations"].get<int>(), 0);
+  EXPECT_GT(report["garments"][0]["factorizations"].get<int>(), 0);
+  if (r.exit_code == 0) EXPECT_LE(report["quality"]["residual"].get<double>(), 0.01);
   EXPECT_TRUE(report["garments"][0]["coarse_start"].is_null());  // coarse-to-fine is off by default
   // Skin through the cloth is reported (not gated), and said on the terminal when there is any.
   const auto& skin = report["skin_through_cloth"];
@@ -121,7 +123,13 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
   const auto dir = test::temp_dir("dress_capped");
-  const auto r = test::run_drape("dress --max-iterations 5 --out " + dir.string());
+  // The implicit solver (the default) stopped after one sewing step.
+  const auto one = test::run_drape("dress --max-iterations 1 --out " + (dir / "implicit").string());
+  EXPECT_EQ(one.exit_code, 3) << one.err;
+  EXPECT_FALSE(read_json(dir / "implicit" / "report.json")["quality"]["settled"].get<bool>());
+  EXPECT_EQ(one.err.find("the body holds it apart"), std::string::npos) << one.err;  // capped, not held
+  // The explicit step stopped after five.
+  const auto r = test::run_drape("dress --solver explicit --max-iterations 5 --out " + dir.string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
   ASSERT_TRUE(std::filesystem::exists(dir / "report.json"));
   EXPECT_TRUE(std::filesystem::exists(dir / "dressed.glb"));
@@ -139,7 +147,15 @@ TEST(DressCli, CappedRunFailsItsGatesWithExit3) {
 TEST(DressCli, StuckSeamIsNamedWithAHint) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const auto dir = test::temp_dir("dress_stuck");
-  const auto r = test::run_drape("dress --garment shirt --size S --body male --out " + dir.string());
+  // The implicit solver (the default): the skirt S on the male body (cut for a 0.78 m waist, his is
+  // 0.86 m) ends in equilibrium with a seam open.
+  const auto skirt = test::run_drape("dress --garment skirt --size S --body male --out " + (dir / "skirt").string());
+  EXPECT_EQ(skirt.exit_code, 3) << skirt.err;
+  EXPECT_NE(skirt.err.find("gate seams_closed failed"), std::string::npos) << skirt.err;
+  EXPECT_NE(skirt.err.find("skirt S: seam '"), std::string::npos) << skirt.err;
+  EXPECT_NE(skirt.err.find("the body holds it apart; a larger size may fit"), std::string::npos) << skirt.err;
+  // The explicit step: sewing stops when the shirt S's armpit seams no longer close on him.
+  const auto r = test::run_drape("dress --solver explicit --garment shirt --size S --body male --out " + dir.string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("gate seams_closed failed"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("shirt S: sewing stopped after"), std::string::npos) << r.err;
@@ -147,7 +163,8 @@ TEST(DressCli, StuckSeamIsNamedWithAHint) {
   const nlohmann::json report = read_json(dir / "report.json");
   EXPECT_TRUE(report["garments"][0]["sewing_stalled"].get<bool>());
   // --sewing-stall 0 sews to the cap: no stall, no hint, the seam still open.
-  const auto capped = test::run_drape("dress --garment shirt --size S --body male --sewing-stall 0 --out " + (dir / "capped").string());
+  const auto capped = test::run_drape("dress --solver explicit --garment shirt --size S --body male --sewing-stall 0 --out " +
+                                      (dir / "capped").string());
   EXPECT_EQ(capped.exit_code, 3) << capped.err;
   EXPECT_EQ(capped.err.find("sewing stopped"), std::string::npos) << capped.err;
   EXPECT_FALSE(read_json(dir / "capped" / "report.json")["garments"][0]["sewing_stalled"].get<bool>());

@@ -19,6 +19,8 @@ namespace drape {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr int kMaxStepsPerFrame = 32;
+
 double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 float centre_height(std::span<const Vec3f> x) {
@@ -178,19 +180,29 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   measure(0, true, r.dressed.quality.residual, 0);
 
   r.simulation_seconds = r.skinning_seconds;
+  std::vector<float> moved(body.mesh.vertex_count());
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
+    // Steps this frame: the 95th percentile of the body's vertex travel over the frame, cut into
+    // steps of at most max_body_step.
+    for (size_t v = 0; v < moved.size(); ++v) moved[v] = (skin[f][v] - skin[f - 1][v]).norm();
+    const size_t p95 = moved.empty() ? 0 : std::min(moved.size() - 1, static_cast<size_t>(0.95 * static_cast<double>(moved.size())));
+    if (!moved.empty()) std::nth_element(moved.begin(), moved.begin() + static_cast<long>(p95), moved.end());
+    const float travel = moved.empty() ? 0.0f : moved[p95];
+    const int steps = std::clamp(static_cast<int>(std::ceil(travel / std::max(o.max_body_step, 1e-4f))), o.substeps, kMaxStepsPerFrame);
     bool converged = true;
     float residual = 0;
     int newton = 0;
-    for (int k = 0; k < o.substeps && r.status == StepStatus::Ok; ++k)
+    for (int k = 0; k < steps && r.status == StepStatus::Ok; ++k)
       for (size_t g = 0; g < ng && r.status == StepStatus::Ok; ++g) {
         ImplicitStepStats stats;
+        settings[g].time_step = frame_time / steps;
         r.status = solvers[g]->step(states[g], colliders, settings[g], &stats, &r.profile);
         converged = converged && stats.converged;
         newton += stats.newton_iterations;
-        if (k + 1 == o.substeps) residual = std::max(residual, stats.residual);
+        if (k + 1 == steps) residual = std::max(residual, stats.residual);
       }
+    r.solver_steps += static_cast<uint64_t>(steps);
     r.simulation_seconds += seconds_since(frame_start);
     measure(f, converged, residual, newton);
     report("simulating", f, frames - 1);

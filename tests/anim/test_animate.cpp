@@ -66,6 +66,16 @@ TEST(Animate, WalkingTwoSecondsKeepsTheShirtOnAndOutOfTheBody) {
   EXPECT_GT(Vec2f(moved.x(), moved.z()).norm(), 0.8f);
 }
 
+// Running (3.5 m/s) moves the body 12 cm a frame: the solver takes more steps in such frames, so
+// the body does not pass through the shirt and leave it behind.
+TEST(Animate, ARunDoesNotTunnelThroughTheShirt) {
+  const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_09_01_run.bvh");
+  if (sanitized()) GTEST_SKIP() << "sanitized build: the run is a Release test";
+  const AnimationResult r = animate(female(), {{load_garment(default_garment_name()), ""}}, read_motion(path), quick_options(-1));
+  EXPECT_GT(r.solver_steps, 4 * (r.frames.size() - 1));
+  expect_every_frame_within_gates(r, 0.02, 0.04f);
+}
+
 TEST(Animate, RaisingTheArmsKeepsTheShirtOnTheShoulders) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/synthetic/synthetic_arms_raise_cmu_skeleton.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: the arms-raise is a Release test";

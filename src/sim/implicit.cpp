@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 #include "sim/parallel.hpp"
@@ -63,6 +64,16 @@ constexpr int kMaxPcgIterations = 16;
 constexpr int kMaxHalvings = 12;
 constexpr double kMaxDampingStep = 10.0;  // s: the weakest quasi-static damping, m / h_d^2
 constexpr double kArmijo = 1e-4;
+
+// CHOLMOD's supernodal factorisation and solves call the BLAS, and a BLAS built without locks
+// (Debian's libopenblas0-serial, which the system picks over the reference BLAS once installed)
+// returns wrong numbers when two threads call it at once, as two dressings on their own threads do
+// (`drape fit` dressing sizes side by side, the web service's workers). One lock for every solver
+// in the process serialises those calls; everything else in a step runs unlocked.
+std::mutex& blas_lock() {
+  static std::mutex lock;
+  return lock;
+}
 
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -458,7 +469,10 @@ bool ImplicitSolver::Impl::preconditioned_solve() {
   d.setZero();
   r = -gradient;
   const double target = kPcgTolerance * r.norm();
-  preconditioned = cholesky.solve(r);
+  {
+    const std::lock_guard<std::mutex> hold(blas_lock());
+    preconditioned = cholesky.solve(r);
+  }
   search = preconditioned;
   double rz = r.dot(preconditioned);
   for (int k = 0; k < kMaxPcgIterations; ++k) {
@@ -469,7 +483,10 @@ bool ImplicitSolver::Impl::preconditioned_solve() {
     d += step * search;
     r -= step * product;
     if (r.norm() <= target) return true;
-    preconditioned = cholesky.solve(r);
+    {
+      const std::lock_guard<std::mutex> hold(blas_lock());
+      preconditioned = cholesky.solve(r);
+    }
     const double rz_next = r.dot(preconditioned);
     search = preconditioned + (rz_next / rz) * search;
     rz = rz_next;
@@ -575,6 +592,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     // matrix changes little from one iteration to the next), or a fresh factorisation when there is
     // none yet in this step or they do not reach the tolerance in kMaxPcgIterations.
     if (!w.factored || !w.preconditioned_solve()) {
+      const std::lock_guard<std::mutex> hold(blas_lock());
       w.cholesky.factorize(w.matrix);
       timer.mark(profile ? profile->factorize : scratch_time);
       if (w.cholesky.info() != Eigen::Success) {

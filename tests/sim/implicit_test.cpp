@@ -5,6 +5,8 @@
 #include <omp.h>
 
 #include <cmath>
+#include <thread>
+#include <vector>
 
 #include "drape/analytic_colliders.hpp"
 #include "drape/implicit.hpp"
@@ -122,6 +124,34 @@ TEST(ImplicitSolver, ResultsDoNotDependOnTheThreadCount) {
     return state_hash(s);
   };
   EXPECT_EQ(run(1), run(2));
+}
+
+// Two solvers stepping at the same time on their own threads, as dressings side by side do (`drape
+// fit`, the web service's workers), give what each gives alone: the sparse factorisation's BLAS
+// calls, which a BLAS built without locks answers wrongly from two threads at once, are serialised.
+TEST(ImplicitSolver, TwoSolversOnTwoThreadsGiveWhatEachGivesAlone) {
+  const ClothModel m = hanging_cloth(40, true);
+  ImplicitSettings settings = default_implicit_settings(m);
+  settings.quasi_static = true;
+  settings.time_step = 0.05;
+  const auto run = [&] {
+    ClothState s = initial_state(m);
+    ImplicitSolver solver(m);
+    for (int k = 0; k < 4; ++k) solver.step(s, {}, settings);
+    return s.x;
+  };
+  const std::vector<Vec3f> alone = run();
+  std::vector<Vec3f> a, b;
+  std::thread first([&] { a = run(); }), second([&] { b = run(); });
+  first.join();
+  second.join();
+  ASSERT_EQ(a.size(), alone.size());
+  ASSERT_EQ(b.size(), alone.size());
+  for (size_t i = 0; i < alone.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(a[i].squaredNorm()) && std::isfinite(b[i].squaredNorm())) << i;
+    ASSERT_EQ(a[i], alone[i]) << i;
+    ASSERT_EQ(b[i], alone[i]) << i;
+  }
 }
 
 }  // namespace

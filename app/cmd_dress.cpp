@@ -42,17 +42,6 @@ struct DressArgs {
   LoadOptions load;
 };
 
-Body load_the_body(const DressArgs& a) {
-  if (!a.measurements.empty()) {
-    if (a.body != "female" && a.body != "male")
-      throw InputError("--measurements", "goes with --body female or male, not a body file");
-    return make_body(a.body == "male" ? Sex::Male : Sex::Female, parse_measurements(a.measurements));
-  }
-  if (a.body == "female" || a.body == "male") return default_body(a.body == "male" ? Sex::Male : Sex::Female);
-  if (!std::filesystem::exists(a.body)) throw InputError(a.body, "no such body file (or use --body female|male)");
-  return load_body(a.body, drape::load_options(a.load.units, a.load.up));
-}
-
 void run_dress(const DressArgs& a) {
   // Everything the user gave is checked before the (long) simulation starts.
   DressOptions o;
@@ -92,7 +81,7 @@ void run_dress(const DressArgs& a) {
     garment_in_size(r.spec, r.size);  // validates the size now (InputError naming the file)
     requests.push_back(std::move(r));
   }
-  const Body body = load_the_body(a);
+  const Body body = load_command_body(a.body, a.measurements, a.load);
 
   std::fprintf(stderr, "dressing a %.2f m body (%zu triangles) in", static_cast<double>(body.measurements.height),
                body.mesh.triangle_count());

@@ -27,22 +27,11 @@ struct FitArgs {
   LoadOptions load;
 };
 
-Body load_fit_body(const FitArgs& a) {
-  if (!a.measurements.empty()) {
-    if (a.body != "female" && a.body != "male")
-      throw InputError("--measurements", "goes with --body female or male, not a body file");
-    return make_body(a.body == "male" ? Sex::Male : Sex::Female, parse_measurements(a.measurements));
-  }
-  if (a.body == "female" || a.body == "male") return default_body(a.body == "male" ? Sex::Male : Sex::Female);
-  if (!std::filesystem::exists(a.body)) throw InputError(a.body, "no such body file (or use --body female|male)");
-  return load_body(a.body, drape::load_options(a.load.units, a.load.up));
-}
-
 void run_fit(const FitArgs& a) {
   // Everything the user gave is checked before the (long) dressing starts.
   const GarmentSpec spec = load_garment(a.garment.empty() ? default_garment_name() : a.garment);
   for (const std::string& size : spec.sizes) garment_in_size(spec, size);
-  const Body body = load_fit_body(a);
+  const Body body = load_command_body(a.body, a.measurements, a.load);
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
   std::fprintf(stderr, "fitting %s in %zu sizes on a %.2f m body (bust %.3f, waist %.3f, hips %.3f m)\n",

@@ -2,6 +2,10 @@
 // Each `drape` subcommand lives in its own file app/cmd_<name>.cpp and registers itself here.
 #include <CLI/CLI.hpp>
 
+#include <string>
+
+#include "drape/body.hpp"
+
 namespace drape::app {
 
 // Options every command that loads meshes shares (DESIGN.md: units and axes are never guessed).
@@ -10,6 +14,10 @@ struct LoadOptions {
   std::string up = "y";     // y|z
 };
 void add_load_options(CLI::App& cmd, LoadOptions& opts);
+
+// The body a command dresses from its --body and --measurements: a built-in (female, male), one
+// made from measurements for that sex, or a body file read with --units and --up.
+Body load_command_body(const std::string& body, const std::string& measurements, const LoadOptions& load);
 
 void add_info_command(CLI::App& app);
 void add_convert_command(CLI::App& app);

@@ -16,23 +16,12 @@
 #include "drape/files.hpp"
 #include "drape/io.hpp"
 #include "drape/render.hpp"
+#include "fit/quality_json.hpp"
 
 namespace drape {
 namespace {
 
 double number(double v) { return std::isfinite(v) ? v : 0.0; }
-
-nlohmann::ordered_json quality_json(const FitQuality& q) {
-  return {{"max_strain", number(q.max_strain)},
-          {"p99_strain", number(q.p99_strain)},
-          {"penetrating_vertices", q.penetrating_vertices},
-          {"penetration_fraction", number(q.penetration_fraction)},
-          {"max_penetration_m", number(q.max_penetration_m)},
-          {"max_seam_gap_m", number(q.max_seam_gap_m)},
-          {"mean_seam_gap_m", number(q.mean_seam_gap_m)},
-          {"settled", q.settled},
-          {"residual", number(q.residual)}};
-}
 
 std::vector<std::string> garment_node_names(const AnimationResult& r) {
   std::vector<std::string> used{"body"}, out;

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "drape/fit.hpp"
+#include "fit/quality_json.hpp"
 
 namespace drape {
 namespace {
@@ -12,18 +13,22 @@ nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 }  // namespace
 
+nlohmann::ordered_json quality_json(const FitQuality& q) {
+  return {{"max_strain", number(q.max_strain)},
+          {"p99_strain", number(q.p99_strain)},
+          {"penetrating_vertices", q.penetrating_vertices},
+          {"penetration_fraction", number(q.penetration_fraction)},
+          {"max_penetration_m", number(q.max_penetration_m)},
+          {"max_seam_gap_m", number(q.max_seam_gap_m)},
+          {"mean_seam_gap_m", number(q.mean_seam_gap_m)},
+          {"settled", q.settled},
+          {"residual", number(q.residual)}};
+}
+
 std::string report_json(const FitQuality& q, const SimulationSummary& s, const std::vector<GateResult>& gates,
                         const std::string& extra_json_object) {
   nlohmann::ordered_json report;
-  report["quality"] = {{"max_strain", number(q.max_strain)},
-                       {"p99_strain", number(q.p99_strain)},
-                       {"penetrating_vertices", q.penetrating_vertices},
-                       {"penetration_fraction", number(q.penetration_fraction)},
-                       {"max_penetration_m", number(q.max_penetration_m)},
-                       {"max_seam_gap_m", number(q.max_seam_gap_m)},
-                       {"mean_seam_gap_m", number(q.mean_seam_gap_m)},
-                       {"settled", q.settled},
-                       {"residual", number(q.residual)}};
+  report["quality"] = quality_json(q);
   report["simulation"] = {{"iterations", s.iterations},
                           {"time_step_s", number(s.time_step_s)},
                           {"wall_seconds", number(s.wall_seconds)},

@@ -108,7 +108,7 @@ void sew_and_drape_implicit(DressedGarment& g, std::span<Collider* const> collid
     g.settled = status == StepStatus::Ok && moved <= o.settle_distance_m;
     if (!g.settled && status == StepStatus::Ok) {
       g.state.x = trial.x;
-      g.residual = std::numeric_limits<float>::infinity();
+      g.residual = solver.residual(g.state.x, colliders, s);
     }
   }
   g.seams_closed = widest_gap(g.state, g.seam_pairs) <= o.seam_closed_m;

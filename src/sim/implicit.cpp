@@ -178,6 +178,11 @@ struct ImplicitSolver::Impl {
   bool planes_valid = false;  // contact planes found at least once  // the factorisation holds a matrix of this step
   Eigen::VectorXd residual_vec, search, product, preconditioned;  // conjugate gradients
   bool preconditioned_solve();
+  // out = A^-1 rhs with the current factorisation (under the BLAS lock).
+  void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+    const std::lock_guard<std::mutex> hold(blas_lock());
+    out = cholesky.solve(rhs);
+  }
 
   Impl(const ClothModel& m, size_t colliders);
   void analyse_pattern();
@@ -469,10 +474,7 @@ bool ImplicitSolver::Impl::preconditioned_solve() {
   d.setZero();
   r = -gradient;
   const double target = kPcgTolerance * r.norm();
-  {
-    const std::lock_guard<std::mutex> hold(blas_lock());
-    preconditioned = cholesky.solve(r);
-  }
+  solve(r, preconditioned);
   search = preconditioned;
   double rz = r.dot(preconditioned);
   for (int k = 0; k < kMaxPcgIterations; ++k) {
@@ -483,10 +485,7 @@ bool ImplicitSolver::Impl::preconditioned_solve() {
     d += step * search;
     r -= step * product;
     if (r.norm() <= target) return true;
-    {
-      const std::lock_guard<std::mutex> hold(blas_lock());
-      preconditioned = cholesky.solve(r);
-    }
+    solve(r, preconditioned);
     const double rz_next = r.dot(preconditioned);
     search = preconditioned + (rz_next / rz) * search;
     rz = rz_next;
@@ -592,15 +591,18 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     // matrix changes little from one iteration to the next), or a fresh factorisation when there is
     // none yet in this step or they do not reach the tolerance in kMaxPcgIterations.
     if (!w.factored || !w.preconditioned_solve()) {
-      const std::lock_guard<std::mutex> hold(blas_lock());
-      w.cholesky.factorize(w.matrix);
+      {
+        const std::lock_guard<std::mutex> hold(blas_lock());
+        w.cholesky.factorize(w.matrix);
+      }
       timer.mark(profile ? profile->factorize : scratch_time);
       if (w.cholesky.info() != Eigen::Success) {
         state.status = StepStatus::NonFinite;
         break;
       }
       w.factored = true;
-      w.direction = w.cholesky.solve(-w.gradient);
+      w.residual_vec = -w.gradient;
+      w.solve(w.residual_vec, w.direction);
       if (profile) ++profile->factorizations;
     }
     timer.mark(profile ? profile->solve : scratch_time);

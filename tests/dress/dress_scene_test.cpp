@@ -23,6 +23,7 @@ namespace drape {
 namespace {
 
 using test::cached_body;
+using test::explicit_options;
 using test::failed_gates;
 using test::sanitized;
 
@@ -72,13 +73,6 @@ TEST(DressScene, DefaultShirtOnDefaultBodyPassesTheGates) {
   EXPECT_LE(q.max_strain, r.garments[0].model.fabric.strain_threshold + 0.01f);
   EXPECT_TRUE(q.settled);
   EXPECT_TRUE(r.passed()) << failed_gates(r);
-}
-
-// Options for the explicit step (the paper's, --solver explicit), whose own settings the tests below try.
-DressOptions explicit_options() {
-  DressOptions o;
-  o.solver = Solver::Explicit;
-  return o;
 }
 
 // The explicit step on the default shirt's grid (2.6 cm), coarse for the shoulders' curvature: with

@@ -22,6 +22,13 @@ inline const Body& cached_body(Sex sex) {
   return it->second;
 }
 
+// Options for the paper's explicit step (--solver explicit), for tests of its own settings.
+inline DressOptions explicit_options() {
+  DressOptions o;
+  o.solver = Solver::Explicit;
+  return o;
+}
+
 inline std::string failed_gates(const DressResult& r) {
   std::string s;
   for (const GateResult& g : r.gates)

@@ -330,9 +330,7 @@ TEST(ImportedPatternDrop, AFlareThatHangsIsNotASkirtThatSlid) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: dressing takes too long";
   const auto body_path = DRAPE_REQUIRE_SHARED("bodies/garmentcode/mean_all.obj");
   const auto pattern = DRAPE_REQUIRE_SHARED("patterns/garmentcode/flare_skirt_specification.json");
-  DressOptions o;
-  o.solver = Solver::Explicit;
-  const DressResult r = dress(mean_all_body(body_path), {{load_garment(pattern.string()), ""}}, o);
+  const DressResult r = dress(mean_all_body(body_path), {{load_garment(pattern.string()), ""}}, test::explicit_options());
   ASSERT_EQ(r.garments.size(), 1u);
   const DressedGarment& g = r.garments[0];
   EXPECT_TRUE(r.quality.finite);
@@ -409,8 +407,7 @@ TEST(ElasticBand, HoldsTheTrousersUp) {
   ASSERT_EQ(with_band.bands.size(), 1u);
   GarmentSpec without_band = with_band;
   without_band.bands.clear();
-  DressOptions o;
-  o.solver = Solver::Explicit;  // two seconds of draping: the explicit step's simulated time
+  DressOptions o = test::explicit_options();  // two seconds of draping: the explicit step's simulated time
   o.max_drape_seconds = 2.0;
   const DressResult held = dress(template_body(), {{with_band, ""}}, o);
   const DressResult fell = dress(template_body(), {{without_band, ""}}, o);

@@ -29,5 +29,6 @@ void add_body_command(CLI::App& app);     // cmd_body.cpp: a rigged body from me
 void add_measure_command(CLI::App& app);  // cmd_measure.cpp: landmarks and measurements of a body
 void add_animate_command(CLI::App& app);  // cmd_animate.cpp: a dressed body in motion
 void add_fit_command(CLI::App& app);      // cmd_fit.cpp: every size tried on, fit maps, a size recommended
+void add_serve_command(CLI::App& app);    // cmd_serve.cpp: the web try-on
 
 }  // namespace drape::app

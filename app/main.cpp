@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   drape::app::add_measure_command(app);
   drape::app::add_animate_command(app);
   drape::app::add_fit_command(app);
+  drape::app::add_serve_command(app);
 
   try {
     app.parse(argc, argv);

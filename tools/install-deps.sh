@@ -11,7 +11,9 @@ packages=(
   libembree-dev libtbb-dev libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libbullet-dev                                         # the peer engine benchmarked beside drape
-  nodejs npm                                            # the Khronos glTF validator
+  nodejs npm                                            # the Khronos glTF validator, the web page's three.js
+  libcpp-httplib-dev                                    # drape serve: HTTP
+  chromium                                              # the web page's browser test (headless)
 )
 
 missing=()
@@ -41,4 +43,11 @@ here=$(cd "$(dirname "$0")" && pwd)
 if [[ ! -d "$here/node_modules/gltf-validator" ]]; then
   echo "make deps: installing gltf-validator (npm)"
   (cd "$here" && npm install --no-audit --no-fund --silent)
+fi
+
+# The web page's three.js and the browser test's puppeteer-core, pinned in web/package-lock.json;
+# drape serve serves web/node_modules/three itself (no CDN).
+if [[ ! -d "$here/../web/node_modules/three" || ! -d "$here/../web/node_modules/puppeteer-core" ]]; then
+  echo "make deps: installing the web page's packages (npm)"
+  (cd "$here/../web" && npm ci --no-audit --no-fund --silent)
 fi

@@ -1,0 +1,100 @@
+// `drape serve`: the web try-on (docs/web.md). An HTTP server with the JSON API of DESIGN.md and the
+// shoppers' page; try-ons are dressed by a pool of workers through a bounded queue.
+#include <pthread.h>
+
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "commands.hpp"
+#include "drape/error.hpp"
+#include "drape/web.hpp"
+
+namespace drape::app {
+namespace {
+
+struct ServeArgs {
+  int port = 8080;
+  std::string host = "127.0.0.1";
+  std::string data = "serve-data";
+  std::string catalogue;
+  std::string web = DRAPE_WEB_ROOT;
+  int workers = 0;
+  size_t queue = 0;
+  std::string keep = "24h";
+  std::string queue_url;
+  double edge = kPaperEdgeLength;
+  uint64_t max_iterations = 0;
+  size_t max_upload_mb = 64;
+};
+
+void run_serve(const ServeArgs& a) {
+  if (!a.queue_url.empty())
+    throw InputError("--queue", "only the in-process queue is available in this build (leave --queue out)");
+  if (!(a.edge >= 0.002 && a.edge <= 0.2)) throw InputError("--edge", "the edge length must be in [0.002, 0.2] m");
+  ServeOptions o;
+  o.data_dir = a.data;
+  o.catalogue_dir = a.catalogue;
+  o.web_root = a.web;
+  o.workers = a.workers;
+  o.queue_capacity = a.queue;
+  o.keep = parse_keep(a.keep);
+  o.max_upload_bytes = a.max_upload_mb << 20;
+  o.dress.mesh.edge_length = a.edge;
+  o.dress.max_iterations = a.max_iterations;
+  // SIGINT and SIGTERM stop the server cleanly (workers joined, no half-written try-on left): they
+  // are blocked in every thread (the server's inherit the mask) and awaited by one that stops it.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  WebServer server(o);
+  const int port = server.bind(a.host, a.port);
+  // The first line on stdout says where to go (tests read the port from it when --port 0).
+  std::printf("drape serve: listening on http://%s:%d/ (data in %s)\n", a.host.c_str(), port, a.data.c_str());
+  std::fflush(stdout);
+  std::thread watcher([&] {
+    int received = 0;
+    sigwait(&signals, &received);
+    std::fprintf(stderr, "drape serve: stopping\n");
+    server.stop();
+  });
+  server.listen();
+  watcher.join();
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto args = std::make_shared<ServeArgs>();
+  CLI::App* cmd = app.add_subcommand("serve", "Serve the web try-on: the shoppers' page and its JSON API");
+  cmd->add_option("--port", args->port, "TCP port (0: any free port, printed on the first line)")
+      ->capture_default_str()->check(CLI::Range(0, 65535));
+  cmd->add_option("--host", args->host, "address to listen on (0.0.0.0: every interface)")->capture_default_str();
+  cmd->add_option("--data", args->data, "folder for bodies, try-on results (private; removed on expiry and on request)")
+      ->capture_default_str();
+  cmd->add_option("--catalogue", args->catalogue, "folder of garment files (drape JSON, GarmentCode, DXF) offered "
+                                                  "beside the built-ins, each named by its file name");
+  cmd->add_option("--web", args->web, "folder of the page (index.html, static/, node_modules/three)")
+      ->capture_default_str();
+  cmd->add_option("--workers", args->workers, "try-ons dressed at once (0: one per core)")
+      ->capture_default_str()->check(CLI::Range(0, 256));
+  cmd->add_option("--queue-size", args->queue, "try-ons that may wait for a worker; more are answered 503 with "
+                                               "Retry-After (0: four per worker)")
+      ->capture_default_str();
+  cmd->add_option("--keep", args->keep, "how long a body and its try-ons are kept: 90s, 30m, 24h, 7d")->capture_default_str();
+  cmd->add_option("--queue", args->queue_url, "job queue URL (only the in-process queue is built in: leave out)");
+  cmd->add_option("--edge", args->edge, "cloth edge length of try-ons in metres (larger: faster, coarser)")
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", args->max_iterations,
+                  "cap on each try-on's iterations per garment (0: none; a capped try-on fails the settled check)")
+      ->capture_default_str();
+  cmd->add_option("--max-upload-mb", args->max_upload_mb, "largest request body in MiB (larger: 413)")
+      ->capture_default_str()->check(CLI::Range(1, 1024));
+  cmd->callback([args] { run_serve(*args); });
+}
+
+}  // namespace drape::app

@@ -1,0 +1,62 @@
+#pragma once
+// The web try-on (`drape serve`, docs/web.md): an HTTP server with a JSON API and the shoppers' page.
+// A shopper makes a body (from measurements or an uploaded scan), picks a garment from the
+// catalogue and a size (or "auto": every size dressed and one recommended), and a pool of workers
+// dresses the body through a bounded queue; the page polls the try-on and shows dressed.glb.
+//
+//   drape::ServeOptions options;
+//   options.data_dir = "serve-data";
+//   drape::WebServer server(options);
+//   const int port = server.bind("127.0.0.1", 0);   // 0: any free port
+//   server.start();                                 // or listen(), which blocks
+//
+// Privacy: a body is reachable only through its random 128-bit id, never listed; it and every
+// try-on of it live under data_dir/bodies/ID/, which DELETE and expiry remove whole.
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "drape/dress.hpp"
+
+namespace drape {
+
+struct ServeOptions {
+  std::filesystem::path data_dir = "drape-data";  // bodies, try-on results, thumbnails
+  std::filesystem::path catalogue_dir;            // garment files offered beside the built-ins; empty: none
+  std::filesystem::path web_root;                 // the page (index.html, static/, node_modules/three); empty: API only
+  int workers = 0;                                // try-ons dressed at once; 0: one per core
+  size_t queue_capacity = 0;                      // try-ons waiting for a worker; 0: four per worker
+  std::chrono::milliseconds keep{std::chrono::hours(24)};  // a body and its try-ons live this long
+  size_t max_upload_bytes = 64u << 20;            // a larger request is refused (413)
+  size_t max_upload_triangles = 2'000'000;        // a body mesh with more is refused (413)
+  DressOptions dress;                             // how try-ons are dressed (mesh edge, iteration cap, ...)
+};
+
+// "90s", "30m", "24h", "7d" (a whole number and a unit). InputError("--keep") otherwise.
+std::chrono::milliseconds parse_keep(std::string_view text);
+
+class WebServer {
+ public:
+  // Loads the catalogue (a garment file that does not load is named on stderr and left out) and
+  // starts the workers. Throws InputError for a catalogue folder or web root that does not exist.
+  explicit WebServer(ServeOptions options);
+  ~WebServer();
+  WebServer(const WebServer&) = delete;
+  WebServer& operator=(const WebServer&) = delete;
+
+  // Binds to host:port (port 0: a free port chosen by the system); returns the port. Throws
+  // std::runtime_error when the address is taken.
+  int bind(const std::string& host, int port);
+  void listen();  // serves until stop()
+  void start();   // serves on a thread of its own
+  void stop();    // stops serving, finishes no new try-ons, joins the workers
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drape

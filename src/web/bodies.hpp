@@ -1,0 +1,30 @@
+#pragma once
+// Bodies a shopper makes: from measurements (JSON) or from an uploaded scan (OBJ, PLY, GLB). Both
+// go through the library's validated loaders and body makers; their errors come back as
+// RequestError with the library's message, the upload named "upload.EXT", never a server path.
+#include <cstddef>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/body.hpp"
+
+namespace drape::web {
+
+// {"sex": "female"|"male" (default female), "measurements": {"height": 1.68, ...}} (metres, keys
+// of measurement_table(); "chest" = bust). No measurements: the built-in body of that sex.
+Body body_from_measurements(const nlohmann::json& request);
+
+struct Upload {
+  std::string filename;  // the shopper's name for it: only its extension is used
+  std::string bytes;
+  std::string units = "m";  // mm|cm|dm|m
+  std::string up = "y";     // y|z
+};
+// Throws RequestError 413 above `max_triangles`, 400 for anything the loaders refuse.
+Body body_from_upload(const Upload& upload, size_t max_triangles);
+
+// The body's tape measurements as JSON (every key of measurement_table(), metres).
+nlohmann::json measurements_json(const Measurements& m);
+
+}  // namespace drape::web

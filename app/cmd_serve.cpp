@@ -25,14 +25,14 @@ struct ServeArgs {
   size_t queue = 0;
   std::string keep = "24h";
   std::string queue_url;
+  std::string lease = "10s";
+  bool worker_only = false;
   double edge = kPaperEdgeLength;
   uint64_t max_iterations = 0;
   size_t max_upload_mb = 64;
 };
 
 void run_serve(const ServeArgs& a) {
-  if (!a.queue_url.empty())
-    throw InputError("--queue", "only the in-process queue is available in this build (leave --queue out)");
   if (!(a.edge >= 0.002 && a.edge <= 0.2)) throw InputError("--edge", "the edge length must be in [0.002, 0.2] m");
   ServeOptions o;
   o.data_dir = a.data;
@@ -44,6 +44,8 @@ void run_serve(const ServeArgs& a) {
   o.max_upload_bytes = a.max_upload_mb << 20;
   o.dress.mesh.edge_length = a.edge;
   o.dress.max_iterations = a.max_iterations;
+  o.queue_url = a.queue_url;
+  o.lease = parse_keep(a.lease);
   // SIGINT and SIGTERM stop the server cleanly (workers joined, no half-written try-on left): they
   // are blocked in every thread (the server's inherit the mask) and awaited by one that stops it.
   sigset_t signals;
@@ -51,6 +53,16 @@ void run_serve(const ServeArgs& a) {
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  if (a.worker_only) {
+    QueueWorkers workers(o);
+    std::printf("drape serve: worker-only, dressing try-ons from %s\n", a.queue_url.c_str());
+    std::fflush(stdout);
+    int received = 0;
+    sigwait(&signals, &received);
+    std::fprintf(stderr, "drape serve: stopping after the try-ons being dressed\n");
+    workers.stop();
+    return;
+  }
   WebServer server(o);
   const int port = server.bind(a.host, a.port);
   // The first line on stdout says where to go (tests read the port from it when --port 0).
@@ -80,13 +92,21 @@ void add_serve_command(CLI::App& app) {
                                                   "beside the built-ins, each named by its file name");
   cmd->add_option("--web", args->web, "folder of the page (index.html, static/, node_modules/three)")
       ->capture_default_str();
-  cmd->add_option("--workers", args->workers, "try-ons dressed at once (0: one per core)")
-      ->capture_default_str()->check(CLI::Range(0, 256));
+  cmd->add_option("--workers", args->workers,
+                  "try-ons dressed at once (0: one per core; -1: none, with --queue: worker-only processes dress)")
+      ->capture_default_str()->check(CLI::Range(-1, 256));
   cmd->add_option("--queue-size", args->queue, "try-ons that may wait for a worker; more are answered 503 with "
                                                "Retry-After (0: four per worker)")
       ->capture_default_str();
   cmd->add_option("--keep", args->keep, "how long a body and its try-ons are kept: 90s, 30m, 24h, 7d")->capture_default_str();
-  cmd->add_option("--queue", args->queue_url, "job queue URL (only the in-process queue is built in: leave out)");
+  cmd->add_option("--queue", args->queue_url,
+                  "shared job queue, redis://HOST:PORT: try-ons go through Redis and `drape serve --worker-only` "
+                  "processes on other machines share the work (default: an in-process queue)");
+  cmd->add_flag("--worker-only", args->worker_only,
+                "serve no HTTP: dress try-ons from --queue with --workers workers (same --catalogue as the server)");
+  cmd->add_option("--lease", args->lease,
+                  "with --queue: a worker silent this long is taken for dead and its try-on queued again (e.g. 10s)")
+      ->capture_default_str();
   cmd->add_option("--edge", args->edge, "cloth edge length of try-ons in metres (larger: faster, coarser)")
       ->capture_default_str();
   cmd->add_option("--max-iterations", args->max_iterations,

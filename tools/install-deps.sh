@@ -12,7 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libbullet-dev                                         # the peer engine benchmarked beside drape
   nodejs npm                                            # the Khronos glTF validator, the web page's three.js
-  libcpp-httplib-dev                                    # drape serve: HTTP
+  libcpp-httplib-dev libhiredis-dev redis-server        # drape serve: HTTP, the shared Redis queue
   chromium                                              # the web page's browser test (headless)
 )
 

@@ -27,12 +27,18 @@ struct ServeOptions {
   std::filesystem::path data_dir = "drape-data";  // bodies, try-on results, thumbnails
   std::filesystem::path catalogue_dir;            // garment files offered beside the built-ins; empty: none
   std::filesystem::path web_root;                 // the page (index.html, static/, node_modules/three); empty: API only
-  int workers = 0;                                // try-ons dressed at once; 0: one per core
+  int workers = 0;                                // try-ons dressed at once; 0: one per core; negative:
+                                                  // none (with queue_url: worker-only processes dress)
   size_t queue_capacity = 0;                      // try-ons waiting for a worker; 0: four per worker
   std::chrono::milliseconds keep{std::chrono::hours(24)};  // a body and its try-ons live this long
   size_t max_upload_bytes = 64u << 20;            // a larger request is refused (413)
   size_t max_upload_triangles = 2'000'000;        // a body mesh with more is refused (413)
   DressOptions dress;                             // how try-ons are dressed (mesh edge, iteration cap, ...)
+  // Shared queue: "redis://HOST:PORT" sends try-ons through Redis, where this server's workers and
+  // `drape serve --worker-only` processes take them; empty: the in-process queue. A worker that
+  // does not renew its lease for this long is taken for dead and its try-on is queued again.
+  std::string queue_url;
+  std::chrono::milliseconds lease{std::chrono::seconds(10)};
 };
 
 // "90s", "30m", "24h", "7d" (a whole number and a unit). InputError("--keep") otherwise.
@@ -53,6 +59,22 @@ class WebServer {
   void listen();  // serves until stop()
   void start();   // serves on a thread of its own
   void stop();    // stops serving, finishes no new try-ons, joins the workers
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// `drape serve --worker-only`: options.workers (0: one per core) workers dressing try-ons from the
+// shared queue options.queue_url, with the catalogue of options.catalogue_dir (the same garment
+// files as the server's), until stop(). Throws std::runtime_error when Redis cannot be reached.
+class QueueWorkers {
+ public:
+  explicit QueueWorkers(ServeOptions options);
+  ~QueueWorkers();
+  QueueWorkers(const QueueWorkers&) = delete;
+  QueueWorkers& operator=(const QueueWorkers&) = delete;
+  void stop();  // finishes the try-ons being dressed
 
  private:
   struct Impl;

@@ -15,33 +15,14 @@
 #include "web/bodies.hpp"
 #include "web/ids.hpp"
 #include "web/request_error.hpp"
+#include "web/redis_queue.hpp"
+#include "web/redis_workers.hpp"
+#include "web/tryon_job.hpp"
 
 namespace drape::web {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// What the page shows of a dressing's report.json: the gates, the quality and the fit in words.
-nlohmann::json shopper_report(const nlohmann::json& full) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const char* key : {"quality", "gates", "fit", "size_advice", "legends"})
-    if (full.contains(key)) out[key] = full[key];
-  out["passed"] = full.contains("gates") && full["gates"].value("passed", false);
-  if (full.contains("garments") && !full["garments"].empty())
-    out["size_reason"] = full["garments"][0].value("size_reason", "");
-  return out;
-}
-
-// A fit map's colour scale as the page draws it: sRGB stops of drape's own colour map, ends and title.
-nlohmann::json legend_json(const Legend& legend) {
-  nlohmann::json stops = nlohmann::json::array();
-  for (int i = 0; i <= 8; ++i) {
-    const Vec3f c = colormap(legend.map, static_cast<float>(i) / 8.0f);
-    const auto byte = [](float v) { return static_cast<int>(std::lround(255.0f * linear_to_srgb(std::clamp(v, 0.0f, 1.0f)))); };
-    stops.push_back(fmt::format("#{:02x}{:02x}{:02x}", byte(c.x()), byte(c.y()), byte(c.z())));
-  }
-  return {{"title", legend.title}, {"lo", legend.lo}, {"hi", legend.hi}, {"stops", stops}};
-}
 
 // Removes what a previous run left: the bodies it held in memory are gone, so their files could
 // never be reached or deleted through the API again.
@@ -67,14 +48,25 @@ const char* to_string(TryOnState state) {
 TryOnService::TryOnService(const ServeOptions& options, Catalogue& catalogue)
     : options_(options), catalogue_(catalogue) {
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  workers_count_ = static_cast<size_t>(options.workers > 0 ? options.workers : cores);
-  capacity_ = options.queue_capacity > 0 ? options.queue_capacity : 4 * workers_count_;
+  workers_count_ = options.workers < 0 ? 0 : static_cast<size_t>(options.workers > 0 ? options.workers : cores);
+  if (workers_count_ == 0 && options.queue_url.empty())
+    throw InputError("--workers", "a server without a shared queue (--queue) needs at least one worker");
+  capacity_ = options.queue_capacity > 0 ? options.queue_capacity : 4 * std::max<size_t>(workers_count_, 1);
   // The cores are shared between the workers: each dressing's OpenMP loops get the rest.
-  omp_threads_per_worker_ = std::max(1, cores / static_cast<int>(workers_count_));
+  omp_threads_per_worker_ = std::max(1, cores / static_cast<int>(std::max<size_t>(workers_count_, 1)));
   std::filesystem::create_directories(options_.data_dir / "bodies");
   clear_unreachable(options_.data_dir / "bodies");
   clear_unreachable(options_.data_dir / "work");
-  for (size_t i = 0; i < workers_count_; ++i) workers_.emplace_back([this] { worker_loop(); });
+  if (!options_.queue_url.empty()) {
+    // Shared queue: this server's workers take try-ons from Redis like any worker-only process,
+    // and a collector brings results back.
+    redis_ = std::make_unique<RedisQueue>(options_.queue_url);
+    reply_list_ = "drape:done:" + random_id();
+    if (workers_count_ > 0) redis_workers_ = std::make_unique<RedisWorkers>(options_, catalogue_, workers_count_);
+    collector_ = std::thread([this] { collector_loop(); });
+  } else {
+    for (size_t i = 0; i < workers_count_; ++i) workers_.emplace_back([this] { worker_loop(); });
+  }
   sweeper_ = std::thread([this] { sweeper_loop(); });
 }
 
@@ -83,13 +75,15 @@ TryOnService::~TryOnService() { stop(); }
 void TryOnService::stop() {
   {
     std::lock_guard lock(mutex_);
-    if (stopping_ && workers_.empty()) return;
-    stopping_ = true;
+    if (stopped_) return;
+    stopped_ = stopping_ = true;
   }
   queue_cv_.notify_all();
   sweeper_cv_.notify_all();
   for (std::thread& t : workers_) t.join();
   workers_.clear();
+  if (redis_workers_) redis_workers_->stop();
+  if (collector_.joinable()) collector_.join();
   if (sweeper_.joinable()) sweeper_.join();
   // Bodies live in this process's memory: once it stops, their files could never be reached or
   // deleted through the API, so they go now.
@@ -107,8 +101,10 @@ BodyView TryOnService::add_body(Body body) {
   view.measurements = measurements_json(body.measurements);
   view.height_m = std::round(1e4 * static_cast<double>(body.measurements.height)) / 1e4;
   // The file is written before the id is handed out, so a body that exists has its file.
-  write_scene(body_dir(view.id) / "body.glb", body_scene(body));
+  const std::vector<unsigned char> glb = encode_glb(body_scene(body));
+  write_file_atomic(body_dir(view.id) / "body.glb", glb);
   std::lock_guard lock(mutex_);
+  if (redis_) redis_->put_body(view.id, std::string(glb.begin(), glb.end()), options_.keep);
   BodyRecord& record = bodies_[view.id];
   record.body = std::make_shared<const Body>(std::move(body));
   record.view = view;
@@ -137,9 +133,11 @@ void TryOnService::remove_body_locked(const std::string& id) {
     const auto tr = tryons_.find(t);
     if (tr == tryons_.end()) continue;
     cache_.erase(tr->second.cache_key);
+    if (redis_ && !tr->second.job.empty()) redis_try([&] { redis_->remove(tr->second.job); });
     tryons_.erase(tr);
     queue_.erase(std::remove(queue_.begin(), queue_.end(), t), queue_.end());
   }
+  if (redis_) redis_try([&] { redis_->delete_body(id); });
   bodies_.erase(it);
   std::error_code ec;
   std::filesystem::remove_all(body_dir(id), ec);
@@ -165,7 +163,7 @@ TryOnService::Submitted TryOnService::submit(const std::string& body_id, const s
   const auto body = bodies_.find(body_id);
   if (body == bodies_.end()) throw RequestError(404, "no such body (it may have expired or been deleted)");
   if (const auto hit = cache_.find(key); hit != cache_.end()) return {hit->second, true};
-  if (queue_.size() >= capacity_) {
+  if ((redis_ ? redis_->queued() : queue_.size()) >= capacity_) {
     ++rejected_;
     throw RequestError(503, "every fitting room is busy; try again shortly");
   }
@@ -176,11 +174,15 @@ TryOnService::Submitted TryOnService::submit(const std::string& body_id, const s
   record.view.size_requested = size;
   record.cache_key = key;
   const std::string id = record.view.id;
+  // Queued first (a Redis that fails answers 500 and leaves nothing half made), then recorded.
+  if (redis_) record.job = redis_->push(RedisJob{id, body_id, garment, size, reply_list_, {}});
   tryons_[id] = std::move(record);
   cache_[key] = id;
   body->second.tryons.push_back(id);
-  queue_.push_back(id);
-  queue_cv_.notify_one();
+  if (!redis_) {
+    queue_.push_back(id);
+    queue_cv_.notify_one();
+  }
   return {id, false};
 }
 
@@ -201,13 +203,21 @@ std::optional<std::filesystem::path> TryOnService::tryon_file(const std::string&
 
 ServiceStats TryOnService::stats() const {
   std::lock_guard lock(mutex_);
-  return {queue_.size(), running_, capacity_, workers_count_, done_, failed_, rejected_};
+  size_t queued = queue_.size(), running = running_;
+  if (redis_) {
+    redis_try([&] { queued = redis_->queued(); });
+    running = 0;
+    for (const auto& [id, t] : tryons_) running += t.view.state == TryOnState::Running;
+  }
+  return {queued, running, capacity_, workers_count_, done_, failed_, rejected_};
 }
 
 int TryOnService::retry_after_seconds() const {
   std::lock_guard lock(mutex_);
   const double mean = done_ + failed_ > 0 ? dress_seconds_total_ / static_cast<double>(done_ + failed_) : 10.0;
-  const double wait = mean * static_cast<double>(queue_.size() + 1) / static_cast<double>(workers_count_);
+  size_t queued = queue_.size();
+  if (redis_) redis_try([&] { queued = redis_->queued(); });
+  const double wait = mean * static_cast<double>(queued + 1) / static_cast<double>(std::max<size_t>(workers_count_, 1));
   return std::clamp(static_cast<int>(std::ceil(wait)), 1, 600);
 }
 
@@ -250,48 +260,9 @@ void TryOnService::dress_one(const std::string& id) {
   };
   const std::filesystem::path staged = options_.data_dir / "work" / id;
   try {
-    const CatalogueEntry& entry = *catalogue_.find(garment_name);
-    const DressOptions& o = options_.dress;
-    DressResult result;
-    FitAnalysis fit;
-    nlohmann::json report;
-    if (size == "auto") {
-      SizeAdvice advice = advise_size(*body, entry.spec, o, [&](size_t done, size_t total) {
-        set_progress(static_cast<double>(done) / static_cast<double>(std::max<size_t>(total, 1)));
-      });
-      // The recommended size is shown; when none closes and stays on, the chart's (else the base
-      // size), and the report says that none fits.
-      size_t shown = advice.recommended;
-      if (!advice.has_recommendation()) {
-        shown = 0;
-        for (size_t i = 0; i < advice.sizes.size(); ++i)
-          if (advice.sizes[i].size == advice.chart_size) shown = i;
-      }
-      SizeTrial& trial = advice.sizes.at(shown);
-      report = nlohmann::json::parse(report_with_fit(dress_report_json(*body, trial.result, o), trial.fit));
-      report["size_advice"] = nlohmann::json::parse(size_advice_json(*body, advice));
-      report["size_advice"]["reasons"] = advice.reasons;
-      result = std::move(trial.result);
-      fit = std::move(trial.fit);
-    } else {
-      const std::vector<GarmentRequest> requests{{entry.spec, size}};
-      // As `drape dress` shows it: sewing is the first half, draping the second.
-      result = dress(*body, requests, o, [&](const DressProgress& p) {
-        const std::string_view phase(p.phase);
-        const double frac = p.phase_limit_seconds > 0 ? std::min(1.0, p.simulated_seconds / p.phase_limit_seconds) : 0.0;
-        set_progress(0.5 * ((phase.ends_with("draping") ? 1.0 : 0.0) + frac));
-      });
-      const std::vector<Garment> made{garment_in_size(entry.spec, result.garments.at(0).size)};
-      fit = analyse_dress_fit(*body, result, made);
-      report = nlohmann::json::parse(report_with_fit(dress_report_json(*body, result, o), fit));
-    }
-    // fit.glb: the garments by strain, the body by the pressure on the skin.
-    report["legends"] = {{"garment", legend_json(strain_legend())}, {"body", legend_json(pressure_legend(fit))}};
-    std::filesystem::remove_all(staged);
-    write_dress_outputs(staged, *body, result, o);
-    write_file_atomic(staged / "report.json", report.dump(2));
-    write_scene(staged / "fit.glb", fit_scene(*body, result, fit));
-    finish(id, TryOnState::Done, result.garments.at(0).size, {}, shopper_report(report), staged);
+    const TryOnOutcome outcome =
+        run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress, staged);
+    finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged);
   } catch (const InputError& e) {
     // A garment file the catalogue took in every size still failed to mesh or place on this body.
     finish(id, TryOnState::Failed, {}, fmt::format("{} could not be dressed on this body: {}", garment_name, e.what()),
@@ -313,6 +284,10 @@ void TryOnService::finish(const std::string& id, TryOnState state, const std::st
     return;
   }
   TryOnView& view = it->second.view;
+  if (view.state == TryOnState::Done || view.state == TryOnState::Failed) {  // answered twice: keep the first
+    std::filesystem::remove_all(staged, ec);
+    return;
+  }
   if (state == TryOnState::Done) {
     const std::filesystem::path dir = body_dir(view.body) / "tryons" / id;
     std::filesystem::create_directories(dir.parent_path(), ec);
@@ -334,6 +309,67 @@ void TryOnService::finish(const std::string& id, TryOnState state, const std::st
     // A failed try-on is not the cached answer: asking again tries again.
     cache_.erase(it->second.cache_key);
     ++failed_;
+  }
+}
+
+void TryOnService::redis_try(const std::function<void()>& action) const {
+  try {
+    action();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drape serve: %s\n", e.what());
+  }
+}
+
+void TryOnService::collector_loop() {
+  // Results come back through this server's own list; between them, the progress of the try-ons
+  // in flight is read, and the jobs of workers whose lease lapsed are queued again.
+  std::unique_ptr<RedisQueue> redis;
+  auto last_sweep = Clock::now();
+  for (;;) {
+    {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return;
+    }
+    try {
+      if (!redis) redis = std::make_unique<RedisQueue>(options_.queue_url);
+      if (const auto done = redis->pop_done(reply_list_, std::chrono::milliseconds(200))) {
+        const std::optional<RedisResult> result = redis->take_result(*done);
+        if (result && is_id(result->tryon)) {
+          const std::filesystem::path staged = options_.data_dir / "work" / result->tryon;
+          std::filesystem::remove_all(staged);
+          for (const auto& [name, bytes] : result->files)
+            if (std::find(std::begin(kTryOnFiles), std::end(kTryOnFiles), name) != std::end(kTryOnFiles))
+              write_file_atomic(staged / name, bytes);
+          finish(result->tryon, result->done ? TryOnState::Done : TryOnState::Failed, result->size, result->error,
+                 result->report, staged);
+        }
+      }
+      std::vector<std::string> waiting;
+      {
+        std::lock_guard lock(mutex_);
+        for (const auto& [id, t] : tryons_)
+          if (t.view.state == TryOnState::Queued || t.view.state == TryOnState::Running) waiting.push_back(id);
+      }
+      for (const std::string& id : waiting) {
+        const std::optional<double> p = redis->progress(id);
+        if (!p) continue;
+        std::lock_guard lock(mutex_);
+        const auto it = tryons_.find(id);
+        if (it == tryons_.end() || it->second.view.state == TryOnState::Done || it->second.view.state == TryOnState::Failed)
+          continue;
+        it->second.view.state = TryOnState::Running;
+        it->second.view.progress = std::max(it->second.view.progress, std::clamp(*p, 0.0, 0.99));
+      }
+      if (Clock::now() - last_sweep > options_.lease / 2) {
+        last_sweep = Clock::now();
+        if (const size_t requeued = redis->requeue_abandoned())
+          std::fprintf(stderr, "drape serve: %zu try-on(s) of a worker that stopped answering queued again\n", requeued);
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "drape serve: shared queue: %s\n", e.what());
+      redis.reset();
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
   }
 }
 

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -24,6 +25,8 @@
 #include "drape/body.hpp"
 #include "drape/web.hpp"
 #include "web/catalogue.hpp"
+#include "web/redis_queue.hpp"
+#include "web/redis_workers.hpp"
 
 namespace drape::web {
 
@@ -87,9 +90,12 @@ class TryOnService {
   struct TryOnRecord {
     TryOnView view;
     std::string cache_key;
+    std::string job;  // shared queue: the job as queued in Redis
   };
 
   void worker_loop();
+  void collector_loop();
+  void redis_try(const std::function<void()>& action) const;  // a Redis failure is logged, not thrown
   void sweeper_loop();
   void dress_one(const std::string& tryon_id);
   void remove_body_locked(const std::string& id);
@@ -104,7 +110,7 @@ class TryOnService {
 
   mutable std::mutex mutex_;
   std::condition_variable queue_cv_, sweeper_cv_;
-  bool stopping_ = false;
+  bool stopping_ = false, stopped_ = false;
   std::map<std::string, BodyRecord> bodies_;
   std::map<std::string, TryOnRecord> tryons_;
   std::map<std::string, std::string> cache_;  // body + garment + size -> try-on id
@@ -113,6 +119,12 @@ class TryOnService {
   double dress_seconds_total_ = 0;
   std::vector<std::thread> workers_;
   std::thread sweeper_;
+  // Shared queue (options.queue_url): a connection for the request threads (under mutex_), this
+  // server's own results list, its workers and the thread that collects results.
+  std::unique_ptr<RedisQueue> redis_;
+  std::string reply_list_;
+  std::unique_ptr<RedisWorkers> redis_workers_;
+  std::thread collector_;
 };
 
 }  // namespace drape::web

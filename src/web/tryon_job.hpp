@@ -1,0 +1,32 @@
+#pragma once
+// One try-on dressed: the work a worker does, wherever it runs (a thread of the server, or a
+// `drape serve --worker-only` process fed through Redis).
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/body.hpp"
+#include "drape/dress.hpp"
+#include "web/catalogue.hpp"
+
+namespace drape::web {
+
+struct TryOnOutcome {
+  std::string size;       // the size dressed (for "auto", the recommended one)
+  nlohmann::json report;  // what the page shows: passed, quality, gates, fit, size_advice, legends
+};
+
+// Dresses `body` in the garment at `size` (a size of it, or "auto": every size dressed and one
+// recommended, docs/fit.md) and writes dressed.glb, fit.glb, preview.png and report.json into
+// `dir` (made empty first). `progress` receives 0..1. Throws InputError when the garment cannot be
+// dressed on this body, std::exception for anything else.
+TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& garment, const std::string& size,
+                       const DressOptions& options, const std::function<void(double)>& progress,
+                       const std::filesystem::path& dir);
+
+// The files a finished try-on has, in the order they are written.
+inline constexpr const char* kTryOnFiles[] = {"dressed.glb", "fit.glb", "preview.png", "report.json"};
+
+}  // namespace drape::web

@@ -1,0 +1,105 @@
+// The web try-on's latency: from POST /api/tryons to the try-on being done, as a shopper's page
+// sees it (polling every 20 ms), with 1 and 4 shoppers at once on loopback against a server with
+// one worker per core. Each try-on is a fresh body (made before the clock starts) in the default
+// shirt, size M, at drape's default resolution, so none is answered from the cache. Reports the
+// median and 95th percentile in seconds, and try-ons per minute.
+//
+//   build-*/bench/bench_web --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "drape/web.hpp"
+// After the Eigen headers: glibc's <resolv.h>, which httplib includes, defines a macro `_res` that
+// Eigen's products use as a parameter name.
+#include <httplib.h>
+
+namespace drape {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double percentile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  const double at = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<size_t>(at);
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (v[hi] - v[lo]) * (at - static_cast<double>(lo));
+}
+
+void BM_TryOnLatency(benchmark::State& state) {
+  const int shoppers = static_cast<int>(state.range(0));
+  const int per_shopper = static_cast<int>(state.range(1));
+  ServeOptions o;
+  o.data_dir = std::filesystem::temp_directory_path() / "drape_bench_web";
+  std::filesystem::remove_all(o.data_dir);
+  WebServer server(o);
+  const int port = server.bind("127.0.0.1", 0);
+  server.start();
+
+  std::vector<double> latencies;
+  size_t failed = 0;
+  double wall = 0;
+  for (auto _ : state) {
+    std::mutex mutex;
+    std::vector<std::thread> threads;
+    const auto start = Clock::now();
+    for (int s = 0; s < shoppers; ++s) {
+      threads.emplace_back([&] {
+        httplib::Client c("127.0.0.1", port);
+        c.set_read_timeout(600, 0);
+        for (int k = 0; k < per_shopper; ++k) {
+          const auto body = c.Post("/api/bodies", "{}", "application/json");
+          if (!body || body->status != 201) continue;
+          const std::string body_id = nlohmann::json::parse(body->body)["id"];
+          const nlohmann::json request{{"body", body_id}, {"garment", "shirt"}, {"size", "M"}};
+          const auto asked = Clock::now();
+          const auto r = c.Post("/api/tryons", request.dump(), "application/json");
+          if (!r || r->status != 202) {
+            std::lock_guard lock(mutex);
+            ++failed;
+            continue;
+          }
+          const std::string id = nlohmann::json::parse(r->body)["id"];
+          std::string at = "queued";
+          while (at == "queued" || at == "running") {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            const auto t = c.Get("/api/tryons/" + id);
+            at = t ? nlohmann::json::parse(t->body).value("state", "failed") : "failed";
+          }
+          const double seconds = std::chrono::duration<double>(Clock::now() - asked).count();
+          std::lock_guard lock(mutex);
+          if (at == "done") latencies.push_back(seconds);
+          else ++failed;
+          c.Delete("/api/bodies/" + body_id);
+        }
+      });
+    }
+    for (std::thread& t : threads) t.join();
+    wall += std::chrono::duration<double>(Clock::now() - start).count();
+  }
+  server.stop();
+  std::filesystem::remove_all(o.data_dir);
+  if (latencies.empty()) {
+    state.SkipWithError("no try-on finished");
+    return;
+  }
+  state.counters["median_s"] = percentile(latencies, 0.5);
+  state.counters["p95_s"] = percentile(latencies, 0.95);
+  state.counters["tryons"] = static_cast<double>(latencies.size());
+  state.counters["failed"] = static_cast<double>(failed);
+  state.counters["per_minute"] = 60.0 * static_cast<double>(latencies.size()) / wall;
+  state.counters["workers"] = std::max(1u, std::thread::hardware_concurrency());
+}
+BENCHMARK(BM_TryOnLatency)->Args({1, 4})->Args({4, 2})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace
+}  // namespace drape
+BENCHMARK_MAIN();

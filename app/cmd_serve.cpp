@@ -33,7 +33,8 @@ struct ServeArgs {
 };
 
 void run_serve(const ServeArgs& a) {
-  if (!(a.edge >= 0.002 && a.edge <= 0.2)) throw InputError("--edge", "the edge length must be in [0.002, 0.2] m");
+  if (!(a.edge >= 0.002 && a.edge <= 0.2))
+    throw InputError("--edge", "the edge length must be in [0.002, 0.2] m");
   ServeOptions o;
   o.data_dir = a.data;
   o.catalogue_dir = a.catalogue;
@@ -84,36 +85,49 @@ void add_serve_command(CLI::App& app) {
   auto args = std::make_shared<ServeArgs>();
   CLI::App* cmd = app.add_subcommand("serve", "Serve the web try-on: the shoppers' page and its JSON API");
   cmd->add_option("--port", args->port, "TCP port (0: any free port, printed on the first line)")
-      ->capture_default_str()->check(CLI::Range(0, 65535));
-  cmd->add_option("--host", args->host, "address to listen on (0.0.0.0: every interface)")->capture_default_str();
-  cmd->add_option("--data", args->data, "folder for bodies, try-on results (private; removed on expiry and on request)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--host", args->host, "address to listen on (0.0.0.0: every interface)")
       ->capture_default_str();
-  cmd->add_option("--catalogue", args->catalogue, "folder of garment files (drape JSON, GarmentCode, DXF) offered "
-                                                  "beside the built-ins, each named by its file name");
+  cmd->add_option("--data", args->data,
+                  "folder for bodies, try-on results (private; removed on expiry and on request)")
+      ->capture_default_str();
+  cmd->add_option("--catalogue", args->catalogue,
+                  "folder of garment files (drape JSON, GarmentCode, DXF) offered "
+                  "beside the built-ins, each named by its file name");
   cmd->add_option("--web", args->web, "folder of the page (index.html, static/, node_modules/three)")
       ->capture_default_str();
-  cmd->add_option("--workers", args->workers,
-                  "try-ons dressed at once (0: one per core; -1: none, with --queue: worker-only processes dress)")
-      ->capture_default_str()->check(CLI::Range(-1, 256));
-  cmd->add_option("--queue-size", args->queue, "try-ons that may wait for a worker; more are answered 503 with "
-                                               "Retry-After (0: four per worker)")
+  cmd->add_option(
+         "--workers", args->workers,
+         "try-ons dressed at once (0: one per core; -1: none, with --queue: worker-only processes dress)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, 256));
+  cmd->add_option("--queue-size", args->queue,
+                  "try-ons that may wait for a worker; more are answered 503 with "
+                  "Retry-After (0: four per worker)")
       ->capture_default_str();
-  cmd->add_option("--keep", args->keep, "how long a body and its try-ons are kept: 90s, 30m, 24h, 7d")->capture_default_str();
-  cmd->add_option("--queue", args->queue_url,
-                  "shared job queue, redis://HOST:PORT: try-ons go through Redis and `drape serve --worker-only` "
-                  "processes on other machines share the work (default: an in-process queue)");
-  cmd->add_flag("--worker-only", args->worker_only,
-                "serve no HTTP: dress try-ons from --queue with --workers workers (same --catalogue as the server)");
-  cmd->add_option("--lease", args->lease,
-                  "with --queue: a worker silent this long is taken for dead and its try-on queued again (e.g. 10s)")
+  cmd->add_option("--keep", args->keep, "how long a body and its try-ons are kept: 90s, 30m, 24h, 7d")
+      ->capture_default_str();
+  cmd->add_option(
+      "--queue", args->queue_url,
+      "shared job queue, redis://HOST:PORT: try-ons go through Redis and `drape serve --worker-only` "
+      "processes on other machines share the work (default: an in-process queue)");
+  cmd->add_flag(
+      "--worker-only", args->worker_only,
+      "serve no HTTP: dress try-ons from --queue with --workers workers (same --catalogue as the server)");
+  cmd->add_option(
+         "--lease", args->lease,
+         "with --queue: a worker silent this long is taken for dead and its try-on queued again (e.g. 10s)")
       ->capture_default_str();
   cmd->add_option("--edge", args->edge, "cloth edge length of try-ons in metres (larger: faster, coarser)")
       ->capture_default_str();
-  cmd->add_option("--max-iterations", args->max_iterations,
-                  "cap on each try-on's iterations per garment (0: none; a capped try-on fails the settled check)")
+  cmd->add_option(
+         "--max-iterations", args->max_iterations,
+         "cap on each try-on's iterations per garment (0: none; a capped try-on fails the settled check)")
       ->capture_default_str();
   cmd->add_option("--max-upload-mb", args->max_upload_mb, "largest request body in MiB (larger: 413)")
-      ->capture_default_str()->check(CLI::Range(1, 1024));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1024));
   cmd->callback([args] { run_serve(*args); });
 }
 

@@ -11,15 +11,12 @@
 #include <chrono>
 #include <filesystem>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <thread>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "drape/web.hpp"
-// After the Eigen headers: glibc's <resolv.h>, which httplib includes, defines a macro `_res` that
-// Eigen's products use as a parameter name.
-#include <httplib.h>
+#include "web/http.hpp"
 
 namespace drape {
 namespace {
@@ -76,8 +73,10 @@ void BM_TryOnLatency(benchmark::State& state) {
           }
           const double seconds = std::chrono::duration<double>(Clock::now() - asked).count();
           std::lock_guard lock(mutex);
-          if (at == "done") latencies.push_back(seconds);
-          else ++failed;
+          if (at == "done")
+            latencies.push_back(seconds);
+          else
+            ++failed;
           c.Delete("/api/bodies/" + body_id);
         }
       });
@@ -98,7 +97,12 @@ void BM_TryOnLatency(benchmark::State& state) {
   state.counters["per_minute"] = 60.0 * static_cast<double>(latencies.size()) / wall;
   state.counters["workers"] = std::max(1u, std::thread::hardware_concurrency());
 }
-BENCHMARK(BM_TryOnLatency)->Args({1, 4})->Args({4, 2})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_TryOnLatency)
+    ->Args({1, 4})
+    ->Args({4, 2})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace drape

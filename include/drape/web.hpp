@@ -26,14 +26,15 @@ namespace drape {
 struct ServeOptions {
   std::filesystem::path data_dir = "drape-data";  // bodies, try-on results, thumbnails
   std::filesystem::path catalogue_dir;            // garment files offered beside the built-ins; empty: none
-  std::filesystem::path web_root;                 // the page (index.html, static/, node_modules/three); empty: API only
-  int workers = 0;                                // try-ons dressed at once; 0: one per core; negative:
-                                                  // none (with queue_url: worker-only processes dress)
-  size_t queue_capacity = 0;                      // try-ons waiting for a worker; 0: four per worker
+  std::filesystem::path web_root;  // the page (index.html, static/, node_modules/three); empty: API only
+  int workers = 0;                 // try-ons dressed at once; 0: one per core; negative:
+                                   // none (with queue_url: worker-only processes dress)
+  size_t queue_capacity = 0;       // try-ons waiting for a worker; 0: four per worker
   std::chrono::milliseconds keep{std::chrono::hours(24)};  // a body and its try-ons live this long
-  size_t max_upload_bytes = 64u << 20;            // a larger request is refused (413)
-  size_t max_upload_triangles = 2'000'000;        // a body mesh with more is refused (413)
-  DressOptions dress;                             // how try-ons are dressed (mesh edge, iteration cap, ...)
+  size_t max_upload_bytes = 64u << 20;                     // a larger request is refused (413)
+  size_t max_upload_triangles = 2'000'000;
+  size_t max_bodies = 10'000;                      // bodies held at once; more are refused (503) until some expire                 // a body mesh with more is refused (413)
+  DressOptions dress;  // how try-ons are dressed (mesh edge, iteration cap, ...)
   // Shared queue: "redis://HOST:PORT" sends try-ons through Redis, where this server's workers and
   // `drape serve --worker-only` processes take them; empty: the in-process queue. A worker that
   // does not renew its lease for this long is taken for dead and its try-on is queued again.

@@ -27,13 +27,14 @@ void refuse_external_files(const std::string& bytes, const std::string& source) 
   if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return;
   const auto u32 = [&](size_t at) {
     uint32_t v = 0;
-    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<size_t>(i)]);
+    for (int i = 3; i >= 0; --i)
+      v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<size_t>(i)]);
     return v;
   };
   const size_t length = u32(12);
   if (length > bytes.size() - 20 || u32(16) != 0x4E4F534Au) return;  // the loader says what is wrong
-  const nlohmann::json gltf = nlohmann::json::parse(bytes.begin() + 20, bytes.begin() + 20 + static_cast<long>(length),
-                                                    nullptr, false);
+  const nlohmann::json gltf = nlohmann::json::parse(
+      bytes.begin() + 20, bytes.begin() + 20 + static_cast<long>(length), nullptr, false);
   if (!gltf.is_object()) return;
   for (const char* kind : {"buffers", "images"}) {
     const auto it = gltf.find(kind);
@@ -51,7 +52,8 @@ void refuse_external_files(const std::string& bytes, const std::string& source) 
 }  // namespace
 
 Body body_from_measurements(const nlohmann::json& request) {
-  if (!request.is_object()) throw RequestError(400, "expected a JSON object with \"sex\" and \"measurements\"");
+  if (!request.is_object())
+    throw RequestError(400, "expected a JSON object with \"sex\" and \"measurements\"");
   Sex sex = Sex::Female;
   if (const auto it = request.find("sex"); it != request.end()) {
     if (!it->is_string() || (*it != "female" && *it != "male"))
@@ -60,7 +62,8 @@ Body body_from_measurements(const nlohmann::json& request) {
   }
   const auto m = request.find("measurements");
   if (m == request.end() || (m->is_object() && m->empty())) return default_body(sex);
-  if (!m->is_object()) throw RequestError(400, "measurements: expected an object of metres, e.g. {\"height\": 1.68}");
+  if (!m->is_object())
+    throw RequestError(400, "measurements: expected an object of metres, e.g. {\"height\": 1.68}");
   std::string text;
   for (const auto& [key, value] : m->items()) {
     if (!value.is_number())
@@ -76,11 +79,15 @@ Body body_from_measurements(const nlohmann::json& request) {
 
 Body body_from_upload(const Upload& upload, size_t max_triangles) {
   std::string ext = std::filesystem::path(upload.filename).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   MeshFormat format = MeshFormat::Obj;
-  if (ext == ".ply") format = MeshFormat::Ply;
-  else if (ext == ".glb") format = MeshFormat::Glb;
-  else if (ext != ".obj") throw RequestError(400, "file: expected an OBJ, PLY or GLB file (.obj, .ply, .glb)");
+  if (ext == ".ply")
+    format = MeshFormat::Ply;
+  else if (ext == ".glb")
+    format = MeshFormat::Glb;
+  else if (ext != ".obj")
+    throw RequestError(400, "file: expected an OBJ, PLY or GLB file (.obj, .ply, .glb)");
   const std::string source = "upload" + ext;
   LoadOptions options;
   try {
@@ -94,7 +101,8 @@ Body body_from_upload(const Upload& upload, size_t max_triangles) {
     const auto* data = reinterpret_cast<const unsigned char*>(upload.bytes.data());
     const Scene scene = parse_scene(std::span(data, upload.bytes.size()), format, source, options, &check);
     if (check.triangles > max_triangles)
-      throw RequestError(413, fmt::format("{}: {} triangles; at most {} are taken", source, check.triangles, max_triangles));
+      throw RequestError(
+          413, fmt::format("{}: {} triangles; at most {} are taken", source, check.triangles, max_triangles));
     // As load_body does for a file, without the file: the skin of a rigged GLB is not kept (the
     // try-on dresses the standing body), so every upload is rigged from its landmarks alike.
     Body body;

@@ -3,9 +3,8 @@
 // go through the library's validated loaders and body makers; their errors come back as
 // RequestError with the library's message, the upload named "upload.EXT", never a server path.
 #include <cstddef>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "drape/body.hpp"
 

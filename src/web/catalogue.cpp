@@ -84,7 +84,8 @@ std::string fabric_colour(const std::string& fabric) {
 }
 
 Catalogue::Catalogue(const std::filesystem::path& folder) {
-  const auto add = [&](GarmentSpec spec, const std::string& name, const std::string& description, bool builtin) {
+  const auto add = [&](GarmentSpec spec, const std::string& name, const std::string& description,
+                       bool builtin) {
     CatalogueEntry e;
     e.name = name;
     e.description = description.empty() ? spec.description : description;
@@ -95,13 +96,15 @@ Catalogue::Catalogue(const std::filesystem::path& folder) {
     entries_.push_back(std::move(e));
   };
   for (const BuiltinGarment& b : builtin_garments())
-    if (std::optional<GarmentSpec> spec = builtin_garment(b.name)) add(std::move(*spec), b.name, b.description, true);
+    if (std::optional<GarmentSpec> spec = builtin_garment(b.name))
+      add(std::move(*spec), b.name, b.description, true);
   if (folder.empty()) return;
   if (!std::filesystem::is_directory(folder)) throw InputError(folder.string(), "no such catalogue folder");
   std::vector<std::filesystem::path> files;
   for (const auto& f : std::filesystem::directory_iterator(folder)) {
     std::string ext = f.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     if (f.is_regular_file() && (ext == ".json" || ext == ".dxf")) files.push_back(f.path());
   }
   std::sort(files.begin(), files.end());

@@ -14,10 +14,10 @@
 namespace drape::web {
 
 struct CatalogueEntry {
-  std::string name;         // the key in URLs: [a-z0-9_-], at most 40 characters
+  std::string name;  // the key in URLs: [a-z0-9_-], at most 40 characters
   std::string description;
   std::string fabric;
-  std::string colour;       // sRGB "#rrggbb": the fabric's colour on the page
+  std::string colour;  // sRGB "#rrggbb": the fabric's colour on the page
   bool builtin = false;
   GarmentSpec spec;
 };

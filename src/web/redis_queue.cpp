@@ -12,7 +12,9 @@ namespace {
 
 constexpr const char* kQueue = "drape:queue";
 
-std::string ms(std::chrono::milliseconds d) { return std::to_string(std::max<long long>(1, d.count())); }
+std::string ms(std::chrono::milliseconds d) {
+  return std::to_string(std::max<long long>(1, d.count()));
+}
 
 }  // namespace
 
@@ -40,7 +42,9 @@ RedisConnection::RedisConnection(const std::string& url) {
   }
 }
 
-RedisConnection::~RedisConnection() { redisFree(context_); }
+RedisConnection::~RedisConnection() {
+  redisFree(context_);
+}
 
 RedisConnection::Reply RedisConnection::command(const std::vector<std::string>& args) {
   std::vector<const char*> argv;
@@ -49,18 +53,25 @@ RedisConnection::Reply RedisConnection::command(const std::vector<std::string>& 
     argv.push_back(a.data());
     lengths.push_back(a.size());
   }
-  auto* reply = static_cast<redisReply*>(redisCommandArgv(context_, static_cast<int>(args.size()), argv.data(), lengths.data()));
-  if (!reply) throw std::runtime_error(std::string("Redis: ") + (context_->errstr[0] ? context_->errstr : "connection lost"));
+  auto* reply = static_cast<redisReply*>(
+      redisCommandArgv(context_, static_cast<int>(args.size()), argv.data(), lengths.data()));
+  if (!reply)
+    throw std::runtime_error(std::string("Redis: ") +
+                             (context_->errstr[0] ? context_->errstr : "connection lost"));
   std::unique_ptr<redisReply, void (*)(void*)> owned(reply, freeReplyObject);
   const auto text = [](const redisReply* r) -> std::optional<std::string> {
     switch (r->type) {
       case REDIS_REPLY_STRING:
-      case REDIS_REPLY_STATUS: return std::string(r->str, r->len);
-      case REDIS_REPLY_INTEGER: return std::to_string(r->integer);
-      default: return std::nullopt;
+      case REDIS_REPLY_STATUS:
+        return std::string(r->str, r->len);
+      case REDIS_REPLY_INTEGER:
+        return std::to_string(r->integer);
+      default:
+        return std::nullopt;
     }
   };
-  if (reply->type == REDIS_REPLY_ERROR) throw std::runtime_error("Redis: " + std::string(reply->str, reply->len));
+  if (reply->type == REDIS_REPLY_ERROR)
+    throw std::runtime_error("Redis: " + std::string(reply->str, reply->len));
   Reply out;
   out.value = text(reply);
   if (reply->type == REDIS_REPLY_ARRAY)
@@ -72,19 +83,28 @@ void RedisQueue::put_body(const std::string& id, const std::string& glb, std::ch
   redis_.command({"SET", "drape:body:" + id, glb, "PX", ms(keep)});
 }
 
-void RedisQueue::delete_body(const std::string& id) { redis_.command({"DEL", "drape:body:" + id}); }
+void RedisQueue::delete_body(const std::string& id) {
+  redis_.command({"DEL", "drape:body:" + id});
+}
 
-size_t RedisQueue::queued() { return std::stoul(redis_.command({"LLEN", kQueue}).value.value_or("0")); }
+size_t RedisQueue::queued() {
+  return std::stoul(redis_.command({"LLEN", kQueue}).value.value_or("0"));
+}
 
 std::string RedisQueue::push(const RedisJob& job) {
-  const nlohmann::json j{{"tryon", job.tryon}, {"body", job.body}, {"garment", job.garment}, {"size", job.size},
+  const nlohmann::json j{{"tryon", job.tryon},
+                         {"body", job.body},
+                         {"garment", job.garment},
+                         {"size", job.size},
                          {"reply", job.reply}};
   std::string text = j.dump();
   redis_.command({"RPUSH", kQueue, text});
   return text;
 }
 
-void RedisQueue::remove(const std::string& job) { redis_.command({"LREM", kQueue, "0", job}); }
+void RedisQueue::remove(const std::string& job) {
+  redis_.command({"LREM", kQueue, "0", job});
+}
 
 std::optional<std::string> RedisQueue::pop_done(const std::string& reply, std::chrono::milliseconds wait) {
   const auto r = redis_.command({"BLPOP", reply, std::to_string(static_cast<double>(wait.count()) / 1000.0)});
@@ -101,11 +121,16 @@ std::optional<RedisResult> RedisQueue::take_result(const std::string& tryon) {
   out.tryon = tryon;
   for (size_t i = 0; i + 1 < r.elements.size(); i += 2) {
     const std::string field = r.elements[i].value_or(""), value = r.elements[i + 1].value_or("");
-    if (field == "state") out.done = value == "done";
-    else if (field == "size") out.size = value;
-    else if (field == "error") out.error = value;
-    else if (field == "report") out.report = nlohmann::json::parse(value, nullptr, false);
-    else if (field.starts_with("file:")) out.files.emplace_back(field.substr(5), value);
+    if (field == "state")
+      out.done = value == "done";
+    else if (field == "size")
+      out.size = value;
+    else if (field == "error")
+      out.error = value;
+    else if (field == "report")
+      out.report = nlohmann::json::parse(value, nullptr, false);
+    else if (field.starts_with("file:"))
+      out.files.emplace_back(field.substr(5), value);
   }
   return out;
 }
@@ -159,8 +184,11 @@ void RedisQueue::set_progress(const std::string& tryon, double progress, std::ch
 void RedisQueue::finish(const std::string& worker, const RedisJob& job, const RedisResult& result,
                         std::chrono::milliseconds keep) {
   const std::string key = "drape:result:" + job.tryon;
-  std::vector<std::string> hset{"HSET", key, "state", result.done ? "done" : "failed", "size", result.size,
-                                "error", result.error, "report", result.report.dump()};
+  std::vector<std::string> hset{"HSET",   key,
+                                "state",  result.done ? "done" : "failed",
+                                "size",   result.size,
+                                "error",  result.error,
+                                "report", result.report.dump()};
   for (const auto& [name, bytes] : result.files) {
     hset.push_back("file:" + name);
     hset.push_back(bytes);

@@ -5,19 +5,18 @@
 // Keys (all under "drape:"): `queue`, a list of jobs (JSON: try-on, body, garment, size, reply
 // list); `body:ID`, a body's GLB (expires with --keep); `processing:WORKER`, the job a worker took
 // (moved there atomically by BLMOVE); `alive:WORKER`, the worker's lease, refreshed by a heartbeat
-// thread, and `workers`, the set of workers seen; `progress:TRYON`; `result:TRYON`, a hash with the state, size, report or error and the
-// four files; `done:SERVER`, the try-ons finished for that server. A worker that dies mid-job
-// stops refreshing its lease; the server moves the job of a worker without a lease back to the
-// front of the queue, and another worker takes it up.
+// thread, and `workers`, the set of workers seen; `progress:TRYON`; `result:TRYON`, a hash with the state,
+// size, report or error and the four files; `done:SERVER`, the try-ons finished for that server. A worker
+// that dies mid-job stops refreshing its lease; the server moves the job of a worker without a lease back to
+// the front of the queue, and another worker takes it up.
 //
 // hiredis contexts are not thread-safe: each thread opens its own RedisConnection.
 #include <chrono>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 struct redisContext;
 
@@ -68,7 +67,7 @@ class RedisQueue {
   void delete_body(const std::string& id);
   size_t queued();
   std::string push(const RedisJob& job);  // returns the job as queued
-  void remove(const std::string& job);     // a queued job taken back (its body was deleted)
+  void remove(const std::string& job);    // a queued job taken back (its body was deleted)
   std::optional<std::string> pop_done(const std::string& reply, std::chrono::milliseconds wait);
   std::optional<RedisResult> take_result(const std::string& tryon);
   std::optional<double> progress(const std::string& tryon);
@@ -80,7 +79,8 @@ class RedisQueue {
   std::optional<RedisJob> take(const std::string& worker, std::chrono::milliseconds wait);
   std::optional<std::string> body(const std::string& id);
   void set_progress(const std::string& tryon, double progress, std::chrono::milliseconds keep);
-  void finish(const std::string& worker, const RedisJob& job, const RedisResult& result, std::chrono::milliseconds keep);
+  void finish(const std::string& worker, const RedisJob& job, const RedisResult& result,
+              std::chrono::milliseconds keep);
 
  private:
   RedisConnection redis_;

@@ -41,7 +41,9 @@ RedisWorkers::RedisWorkers(const ServeOptions& options, const Catalogue& catalog
   for (const std::string& id : ids_) threads_.emplace_back([this, id] { work(id); });
 }
 
-RedisWorkers::~RedisWorkers() { stop(); }
+RedisWorkers::~RedisWorkers() {
+  stop();
+}
 
 void RedisWorkers::stop() {
   stopping_ = true;
@@ -87,7 +89,8 @@ void RedisWorkers::work(const std::string& worker) {
     ++running_;
     RedisResult result;
     result.tryon = job->tryon;
-    const std::filesystem::path staged = options_.data_dir / "work" / (is_id(job->tryon) ? job->tryon : random_id());
+    const std::filesystem::path staged =
+        options_.data_dir / "work" / (is_id(job->tryon) ? job->tryon : random_id());
     try {
       const CatalogueEntry* garment = catalogue_.find(job->garment);
       const std::optional<std::string> glb = is_id(job->body) ? redis->body(job->body) : std::nullopt;
@@ -101,12 +104,15 @@ void RedisWorkers::work(const std::string& worker) {
         redis->set_progress(job->tryon, 0.0, options_.keep);
         const Body body = body_from_upload(Upload{"body.glb", *glb, "m", "y"}, options_.max_upload_triangles);
         double shown = 0;
-        const TryOnOutcome outcome = run_tryon(body, *garment, job->size, options_.dress, [&](double p) {
-          // Throttled: a few hundred updates per try-on at most.
-          if (p < shown + 0.01) return;
-          shown = p;
-          redis->set_progress(job->tryon, std::min(p, 0.99), options_.keep);
-        }, staged);
+        const TryOnOutcome outcome = run_tryon(
+            body, *garment, job->size, options_.dress,
+            [&](double p) {
+              // Throttled: a few hundred updates per try-on at most.
+              if (p < shown + 0.01) return;
+              shown = p;
+              redis->set_progress(job->tryon, std::min(p, 0.99), options_.keep);
+            },
+            staged);
         result.done = true;
         result.size = outcome.size;
         result.report = outcome.report;
@@ -144,17 +150,21 @@ struct QueueWorkers::Impl {
   explicit Impl(ServeOptions o)
       : options(std::move(o)),
         catalogue(options.catalogue_dir),
-        workers(options, catalogue,
-                static_cast<size_t>(options.workers > 0 ? options.workers
-                                                        : std::max(1u, std::thread::hardware_concurrency()))) {}
+        workers(
+            options, catalogue,
+            static_cast<size_t>(options.workers > 0 ? options.workers
+                                                    : std::max(1u, std::thread::hardware_concurrency()))) {}
 };
 
 QueueWorkers::QueueWorkers(ServeOptions options) {
-  if (options.queue_url.empty()) throw InputError("--queue", "a worker-only process needs the shared queue's URL");
+  if (options.queue_url.empty())
+    throw InputError("--queue", "a worker-only process needs the shared queue's URL");
   impl_ = std::make_unique<Impl>(std::move(options));
 }
 
-QueueWorkers::~QueueWorkers() { stop(); }
+QueueWorkers::~QueueWorkers() {
+  stop();
+}
 
 void QueueWorkers::stop() {
   if (impl_) impl_->workers.stop();

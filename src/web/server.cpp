@@ -13,12 +13,10 @@
 #include "drape/web.hpp"
 #include "web/bodies.hpp"
 #include "web/catalogue.hpp"
+#include "web/http.hpp"
 #include "web/ids.hpp"
 #include "web/request_error.hpp"
 #include "web/service.hpp"
-// After every header that uses Eigen: glibc's <resolv.h>, which httplib includes, defines a macro
-// `_res` that Eigen's products use as a parameter name.
-#include <httplib.h>
 
 namespace drape {
 namespace {
@@ -52,13 +50,20 @@ bool send_file(httplib::Response& res, const std::filesystem::path& path) {
 // The standard words for statuses no route answered itself (unknown path, body too large, ...).
 std::string status_message(int status) {
   switch (status) {
-    case 400: return "the request is malformed";
-    case 404: return "not found";
-    case 405: return "that method is not allowed here";
-    case 413: return "the upload is too large";
-    case 414: return "the address is too long";
-    case 415: return "unsupported content type";
-    default: return status >= 500 ? "the server could not answer; please try again" : "the request was refused";
+    case 400:
+      return "the request is malformed";
+    case 404:
+      return "not found";
+    case 405:
+      return "that method is not allowed here";
+    case 413:
+      return "the upload is too large";
+    case 414:
+      return "the address is too long";
+    case 415:
+      return "unsupported content type";
+    default:
+      return status >= 500 ? "the server could not answer; please try again" : "the request was refused";
   }
 }
 
@@ -78,7 +83,8 @@ json tryon_json(const web::TryOnView& t) {
   if (t.state == web::TryOnState::Failed) out["error"] = t.error;
   if (t.state == web::TryOnState::Done) {
     const std::string base = "/api/tryons/" + t.id + "/";
-    out["files"] = json{{"dressed", base + "dressed.glb"}, {"fit", base + "fit.glb"}, {"preview", base + "preview.png"}};
+    out["files"] =
+        json{{"dressed", base + "dressed.glb"}, {"fit", base + "fit.glb"}, {"preview", base + "preview.png"}};
   }
   return out;
 }
@@ -90,11 +96,16 @@ std::chrono::milliseconds parse_keep(std::string_view text) {
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
   const std::string_view unit(ptr, static_cast<size_t>(text.data() + text.size() - ptr));
   long long seconds_per_unit = 0;
-  if (unit == "s") seconds_per_unit = 1;
-  else if (unit == "m") seconds_per_unit = 60;
-  else if (unit == "h") seconds_per_unit = 3600;
-  else if (unit == "d") seconds_per_unit = 86400;
-  if (ec != std::errc() || ptr == text.data() || n <= 0 || seconds_per_unit == 0 || n > 3650 * 86400 / seconds_per_unit)
+  if (unit == "s")
+    seconds_per_unit = 1;
+  else if (unit == "m")
+    seconds_per_unit = 60;
+  else if (unit == "h")
+    seconds_per_unit = 3600;
+  else if (unit == "d")
+    seconds_per_unit = 86400;
+  if (ec != std::errc() || ptr == text.data() || n <= 0 || seconds_per_unit == 0 ||
+      n > 3650 * 86400 / seconds_per_unit)
     throw InputError("--keep", "'" + std::string(text) + "' is not a duration like 90s, 30m, 24h or 7d");
   return std::chrono::seconds(n * seconds_per_unit);
 }
@@ -123,16 +134,17 @@ void WebServer::Impl::routes() {
   http.set_write_timeout(30, 0);
   http.set_default_headers({{"X-Content-Type-Options", "nosniff"}, {"Referrer-Policy", "no-referrer"}});
   // Statuses httplib answers itself (no route, 413 for a body over the limit) get the API's shape.
-  http.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
-    if (res.body.empty()) send_error(res, res.status, status_message(res.status));
-    return httplib::Server::HandlerResponse::Handled;
-  }));
+  http.set_error_handler(
+      httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+        if (res.body.empty()) send_error(res, res.status, status_message(res.status));
+        return httplib::Server::HandlerResponse::Handled;
+      }));
   http.set_exception_handler([](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
     try {
       std::rethrow_exception(ep);
     } catch (const web::RequestError& e) {
       send_error(res, e.status(), e.what());
-      if (e.status() == 503) res.set_header("Retry-After", "10");
+      if (e.status() == 503) res.set_header("Retry-After", "60");
     } catch (const InputError& e) {
       send_error(res, 400, e.what());
     } catch (const std::exception& e) {
@@ -158,7 +170,8 @@ void WebServer::Impl::routes() {
     json list = json::array();
     for (const web::CatalogueEntry& e : catalogue.entries()) {
       json chart = json::array();
-      for (size_t i = 0; i < e.spec.size_chart.size() && i < e.spec.sizes.size(); ++i) chart.push_back(e.spec.sizes[i]);
+      for (size_t i = 0; i < e.spec.size_chart.size() && i < e.spec.sizes.size(); ++i)
+        chart.push_back(e.spec.sizes[i]);
       list.push_back(json{{"name", e.name},
                           {"description", e.description},
                           {"fabric", e.fabric},
@@ -172,15 +185,17 @@ void WebServer::Impl::routes() {
     send_json(res, 200, json{{"garments", list}});
   });
 
-  http.Get(R"(/api/garments/([^/]+)/thumbnail\.png)", [this](const httplib::Request& req, httplib::Response& res) {
-    const web::CatalogueEntry* e = catalogue.find(req.matches[1]);
-    if (!e) return send_error(res, 404, "no such garment");
-    const auto png = catalogue.thumbnail(*e);
-    res.set_content(*png, "image/png");
-    res.set_header("Cache-Control", "public, max-age=3600");
-  });
+  http.Get(R"(/api/garments/([^/]+)/thumbnail\.png)",
+           [this](const httplib::Request& req, httplib::Response& res) {
+             const web::CatalogueEntry* e = catalogue.find(req.matches[1]);
+             if (!e) return send_error(res, 404, "no such garment");
+             const auto png = catalogue.thumbnail(*e);
+             res.set_content(*png, "image/png");
+             res.set_header("Cache-Control", "public, max-age=3600");
+           });
 
-  http.Post("/api/bodies", [this](const httplib::Request& req, httplib::Response& res) { post_body(req, res); });
+  http.Post("/api/bodies",
+            [this](const httplib::Request& req, httplib::Response& res) { post_body(req, res); });
 
   http.Get(R"(/api/bodies/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
     const auto body = web::is_id(req.matches[1].str()) ? service.body(req.matches[1]) : std::nullopt;
@@ -190,7 +205,8 @@ void WebServer::Impl::routes() {
   });
 
   http.Get(R"(/api/bodies/([^/]+)/([a-z.]+))", [this](const httplib::Request& req, httplib::Response& res) {
-    const auto path = web::is_id(req.matches[1].str()) ? service.body_file(req.matches[1], req.matches[2]) : std::nullopt;
+    const auto path =
+        web::is_id(req.matches[1].str()) ? service.body_file(req.matches[1], req.matches[2]) : std::nullopt;
     if (!path || !send_file(res, *path)) send_error(res, 404, "no such body file");
   });
 
@@ -200,7 +216,8 @@ void WebServer::Impl::routes() {
     res.status = 204;
   });
 
-  http.Post("/api/tryons", [this](const httplib::Request& req, httplib::Response& res) { post_tryon(req, res); });
+  http.Post("/api/tryons",
+            [this](const httplib::Request& req, httplib::Response& res) { post_tryon(req, res); });
 
   http.Get(R"(/api/tryons/([^/]+))", [this](const httplib::Request& req, httplib::Response& res) {
     const auto t = web::is_id(req.matches[1].str()) ? service.tryon(req.matches[1]) : std::nullopt;
@@ -256,7 +273,9 @@ void WebServer::Impl::post_body(const httplib::Request& req, httplib::Response& 
   } else {
     const json request = json::parse(req.body, nullptr, false);
     if (request.is_discarded())
-      return send_error(res, 400, "expected JSON {\"sex\": ..., \"measurements\": {...}} or a multipart upload of a body file");
+      return send_error(
+          res, 400,
+          "expected JSON {\"sex\": ..., \"measurements\": {...}} or a multipart upload of a body file");
     body = web::body_from_measurements(request);
   }
   send_json(res, 201, body_json(service.add_body(std::move(body))));
@@ -266,7 +285,8 @@ void WebServer::Impl::post_body(const httplib::Request& req, httplib::Response& 
 void WebServer::Impl::post_tryon(const httplib::Request& req, httplib::Response& res) {
   const json request = json::parse(req.body, nullptr, false);
   if (request.is_discarded() || !request.is_object())
-    return send_error(res, 400, "expected JSON {\"body\": ID, \"garment\": NAME, \"size\": SIZE or \"auto\"}");
+    return send_error(res, 400,
+                      "expected JSON {\"body\": ID, \"garment\": NAME, \"size\": SIZE or \"auto\"}");
   for (const char* key : {"body", "garment", "size"})
     if (!request.contains(key) || !request[key].is_string())
       return send_error(res, 400, fmt::format("{}: missing (a string)", key));
@@ -283,15 +303,20 @@ void WebServer::Impl::post_tryon(const httplib::Request& req, httplib::Response&
 
 WebServer::WebServer(ServeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
 
-WebServer::~WebServer() { stop(); }
+WebServer::~WebServer() {
+  stop();
+}
 
 int WebServer::bind(const std::string& host, int port) {
-  const int bound = port == 0 ? impl_->http.bind_to_any_port(host) : (impl_->http.bind_to_port(host, port) ? port : -1);
+  const int bound =
+      port == 0 ? impl_->http.bind_to_any_port(host) : (impl_->http.bind_to_port(host, port) ? port : -1);
   if (bound < 0) throw std::runtime_error(fmt::format("cannot listen on {}:{} (in use?)", host, port));
   return bound;
 }
 
-void WebServer::listen() { impl_->http.listen_after_bind(); }
+void WebServer::listen() {
+  impl_->http.listen_after_bind();
+}
 
 void WebServer::start() {
   // bind() already listens: connections made before the accept loop runs wait in the backlog.

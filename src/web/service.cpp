@@ -14,9 +14,9 @@
 #include "drape/size_advice.hpp"
 #include "web/bodies.hpp"
 #include "web/ids.hpp"
-#include "web/request_error.hpp"
 #include "web/redis_queue.hpp"
 #include "web/redis_workers.hpp"
+#include "web/request_error.hpp"
 #include "web/tryon_job.hpp"
 
 namespace drape::web {
@@ -37,10 +37,14 @@ void clear_unreachable(const std::filesystem::path& dir) {
 
 const char* to_string(TryOnState state) {
   switch (state) {
-    case TryOnState::Queued: return "queued";
-    case TryOnState::Running: return "running";
-    case TryOnState::Done: return "done";
-    case TryOnState::Failed: return "failed";
+    case TryOnState::Queued:
+      return "queued";
+    case TryOnState::Running:
+      return "running";
+    case TryOnState::Done:
+      return "done";
+    case TryOnState::Failed:
+      return "failed";
   }
   return "failed";
 }
@@ -48,7 +52,8 @@ const char* to_string(TryOnState state) {
 TryOnService::TryOnService(const ServeOptions& options, Catalogue& catalogue)
     : options_(options), catalogue_(catalogue) {
   const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  workers_count_ = options.workers < 0 ? 0 : static_cast<size_t>(options.workers > 0 ? options.workers : cores);
+  workers_count_ =
+      options.workers < 0 ? 0 : static_cast<size_t>(options.workers > 0 ? options.workers : cores);
   if (workers_count_ == 0 && options.queue_url.empty())
     throw InputError("--workers", "a server without a shared queue (--queue) needs at least one worker");
   capacity_ = options.queue_capacity > 0 ? options.queue_capacity : 4 * std::max<size_t>(workers_count_, 1);
@@ -62,7 +67,8 @@ TryOnService::TryOnService(const ServeOptions& options, Catalogue& catalogue)
     // and a collector brings results back.
     redis_ = std::make_unique<RedisQueue>(options_.queue_url);
     reply_list_ = "drape:done:" + random_id();
-    if (workers_count_ > 0) redis_workers_ = std::make_unique<RedisWorkers>(options_, catalogue_, workers_count_);
+    if (workers_count_ > 0)
+      redis_workers_ = std::make_unique<RedisWorkers>(options_, catalogue_, workers_count_);
     collector_ = std::thread([this] { collector_loop(); });
   } else {
     for (size_t i = 0; i < workers_count_; ++i) workers_.emplace_back([this] { worker_loop(); });
@@ -70,7 +76,9 @@ TryOnService::TryOnService(const ServeOptions& options, Catalogue& catalogue)
   sweeper_ = std::thread([this] { sweeper_loop(); });
 }
 
-TryOnService::~TryOnService() { stop(); }
+TryOnService::~TryOnService() {
+  stop();
+}
 
 void TryOnService::stop() {
   {
@@ -96,6 +104,12 @@ std::filesystem::path TryOnService::body_dir(const std::string& id) const {
 }
 
 BodyView TryOnService::add_body(Body body) {
+  {
+    // Bodies are held in memory until they expire: a bound keeps a flood of them from exhausting it.
+    std::lock_guard lock(mutex_);
+    if (bodies_.size() >= options_.max_bodies)
+      throw RequestError(503, "the fitting room is full; please try again later");
+  }
   BodyView view;
   view.id = random_id();
   view.measurements = measurements_json(body.measurements);
@@ -119,7 +133,8 @@ std::optional<BodyView> TryOnService::body(const std::string& id) const {
   return it->second.view;
 }
 
-std::optional<std::filesystem::path> TryOnService::body_file(const std::string& id, const std::string& name) const {
+std::optional<std::filesystem::path> TryOnService::body_file(const std::string& id,
+                                                             const std::string& name) const {
   if (name != "body.glb") return std::nullopt;
   std::lock_guard lock(mutex_);
   if (!is_id(id) || !bodies_.count(id)) return std::nullopt;
@@ -193,8 +208,10 @@ std::optional<TryOnView> TryOnService::tryon(const std::string& id) const {
   return it->second.view;
 }
 
-std::optional<std::filesystem::path> TryOnService::tryon_file(const std::string& id, const std::string& name) const {
-  if (name != "dressed.glb" && name != "fit.glb" && name != "preview.png" && name != "report.json") return std::nullopt;
+std::optional<std::filesystem::path> TryOnService::tryon_file(const std::string& id,
+                                                              const std::string& name) const {
+  if (name != "dressed.glb" && name != "fit.glb" && name != "preview.png" && name != "report.json")
+    return std::nullopt;
   std::lock_guard lock(mutex_);
   const auto it = tryons_.find(id);
   if (it == tryons_.end() || it->second.view.state != TryOnState::Done) return std::nullopt;
@@ -214,10 +231,12 @@ ServiceStats TryOnService::stats() const {
 
 int TryOnService::retry_after_seconds() const {
   std::lock_guard lock(mutex_);
-  const double mean = done_ + failed_ > 0 ? dress_seconds_total_ / static_cast<double>(done_ + failed_) : 10.0;
+  const double mean =
+      done_ + failed_ > 0 ? dress_seconds_total_ / static_cast<double>(done_ + failed_) : 10.0;
   size_t queued = queue_.size();
   if (redis_) redis_try([&] { queued = redis_->queued(); });
-  const double wait = mean * static_cast<double>(queued + 1) / static_cast<double>(std::max<size_t>(workers_count_, 1));
+  const double wait =
+      mean * static_cast<double>(queued + 1) / static_cast<double>(std::max<size_t>(workers_count_, 1));
   return std::clamp(static_cast<int>(std::ceil(wait)), 1, 600);
 }
 
@@ -265,17 +284,18 @@ void TryOnService::dress_one(const std::string& id) {
     finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged);
   } catch (const InputError& e) {
     // A garment file the catalogue took in every size still failed to mesh or place on this body.
-    finish(id, TryOnState::Failed, {}, fmt::format("{} could not be dressed on this body: {}", garment_name, e.what()),
-           {}, staged);
+    finish(id, TryOnState::Failed, {},
+           fmt::format("{} could not be dressed on this body: {}", garment_name, e.what()), {}, staged);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "drape serve: a try-on failed: %s\n", e.what());
-    finish(id, TryOnState::Failed, {}, "the dressing failed on the server; please try again or pick another size", {},
-           staged);
+    finish(id, TryOnState::Failed, {},
+           "the dressing failed on the server; please try again or pick another size", {}, staged);
   }
 }
 
-void TryOnService::finish(const std::string& id, TryOnState state, const std::string& size, const std::string& error,
-                          nlohmann::json report, const std::filesystem::path& staged) {
+void TryOnService::finish(const std::string& id, TryOnState state, const std::string& size,
+                          const std::string& error, nlohmann::json report,
+                          const std::filesystem::path& staged) {
   std::error_code ec;
   std::lock_guard lock(mutex_);
   const auto it = tryons_.find(id);
@@ -340,22 +360,24 @@ void TryOnService::collector_loop() {
           for (const auto& [name, bytes] : result->files)
             if (std::find(std::begin(kTryOnFiles), std::end(kTryOnFiles), name) != std::end(kTryOnFiles))
               write_file_atomic(staged / name, bytes);
-          finish(result->tryon, result->done ? TryOnState::Done : TryOnState::Failed, result->size, result->error,
-                 result->report, staged);
+          finish(result->tryon, result->done ? TryOnState::Done : TryOnState::Failed, result->size,
+                 result->error, result->report, staged);
         }
       }
       std::vector<std::string> waiting;
       {
         std::lock_guard lock(mutex_);
         for (const auto& [id, t] : tryons_)
-          if (t.view.state == TryOnState::Queued || t.view.state == TryOnState::Running) waiting.push_back(id);
+          if (t.view.state == TryOnState::Queued || t.view.state == TryOnState::Running)
+            waiting.push_back(id);
       }
       for (const std::string& id : waiting) {
         const std::optional<double> p = redis->progress(id);
         if (!p) continue;
         std::lock_guard lock(mutex_);
         const auto it = tryons_.find(id);
-        if (it == tryons_.end() || it->second.view.state == TryOnState::Done || it->second.view.state == TryOnState::Failed)
+        if (it == tryons_.end() || it->second.view.state == TryOnState::Done ||
+            it->second.view.state == TryOnState::Failed)
           continue;
         it->second.view.state = TryOnState::Running;
         it->second.view.progress = std::max(it->second.view.progress, std::clamp(*p, 0.0, 0.99));
@@ -363,7 +385,8 @@ void TryOnService::collector_loop() {
       if (Clock::now() - last_sweep > options_.lease / 2) {
         last_sweep = Clock::now();
         if (const size_t requeued = redis->requeue_abandoned())
-          std::fprintf(stderr, "drape serve: %zu try-on(s) of a worker that stopped answering queued again\n", requeued);
+          std::fprintf(stderr, "drape serve: %zu try-on(s) of a worker that stopped answering queued again\n",
+                       requeued);
       }
     } catch (const std::exception& e) {
       std::fprintf(stderr, "drape serve: shared queue: %s\n", e.what());
@@ -375,8 +398,8 @@ void TryOnService::collector_loop() {
 
 void TryOnService::sweeper_loop() {
   // Checks a few times per keep period (at most every minute), so nothing outlives it by much.
-  const auto interval = std::clamp<std::chrono::milliseconds>(options_.keep / 4, std::chrono::milliseconds(20),
-                                                              std::chrono::minutes(1));
+  const auto interval = std::clamp<std::chrono::milliseconds>(
+      options_.keep / 4, std::chrono::milliseconds(20), std::chrono::minutes(1));
   std::unique_lock lock(mutex_);
   while (!stopping_) {
     sweeper_cv_.wait_for(lock, interval, [&] { return stopping_; });

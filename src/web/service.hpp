@@ -10,17 +10,16 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
-#include <functional>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "drape/body.hpp"
 #include "drape/web.hpp"
@@ -36,10 +35,10 @@ const char* to_string(TryOnState state);
 struct TryOnView {
   std::string id, body, garment, size_requested;
   TryOnState state = TryOnState::Queued;
-  double progress = 0;          // 0..1
-  std::string size;             // the size dressed (known once done; for "auto", the recommended one)
-  std::string error;            // why it failed, in the shopper's words
-  nlohmann::json report;        // done: passed, quality, gates, fit (and size_advice for "auto")
+  double progress = 0;    // 0..1
+  std::string size;       // the size dressed (known once done; for "auto", the recommended one)
+  std::string error;      // why it failed, in the shopper's words
+  nlohmann::json report;  // done: passed, quality, gates, fit (and size_advice for "auto")
 };
 
 struct BodyView {
@@ -99,8 +98,8 @@ class TryOnService {
   void sweeper_loop();
   void dress_one(const std::string& tryon_id);
   void remove_body_locked(const std::string& id);
-  void finish(const std::string& tryon_id, TryOnState state, const std::string& size, const std::string& error,
-              nlohmann::json report, const std::filesystem::path& staged);
+  void finish(const std::string& tryon_id, TryOnState state, const std::string& size,
+              const std::string& error, nlohmann::json report, const std::filesystem::path& staged);
   std::filesystem::path body_dir(const std::string& id) const;
 
   ServeOptions options_;

@@ -29,7 +29,9 @@ nlohmann::json legend_json(const Legend& legend) {
   nlohmann::json stops = nlohmann::json::array();
   for (int i = 0; i <= 8; ++i) {
     const Vec3f c = colormap(legend.map, static_cast<float>(i) / 8.0f);
-    const auto byte = [](float v) { return static_cast<int>(std::lround(255.0f * linear_to_srgb(std::clamp(v, 0.0f, 1.0f)))); };
+    const auto byte = [](float v) {
+      return static_cast<int>(std::lround(255.0f * linear_to_srgb(std::clamp(v, 0.0f, 1.0f))));
+    };
     stops.push_back(fmt::format("#{:02x}{:02x}{:02x}", byte(c.x()), byte(c.y()), byte(c.z())));
   }
   return {{"title", legend.title}, {"lo", legend.lo}, {"hi", legend.hi}, {"stops", stops}};
@@ -66,7 +68,8 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
     // As `drape dress` shows it: sewing is the first half, draping the second.
     result = dress(body, requests, o, [&](const DressProgress& p) {
       const std::string_view phase(p.phase);
-      const double frac = p.phase_limit_seconds > 0 ? std::min(1.0, p.simulated_seconds / p.phase_limit_seconds) : 0.0;
+      const double frac =
+          p.phase_limit_seconds > 0 ? std::min(1.0, p.simulated_seconds / p.phase_limit_seconds) : 0.0;
       set_progress(0.5 * ((phase.ends_with("draping") ? 1.0 : 0.0) + frac));
     });
     const std::vector<Garment> made{garment_in_size(entry.spec, result.garments.at(0).size)};
@@ -74,7 +77,8 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
     report = nlohmann::json::parse(report_with_fit(dress_report_json(body, result, o), fit));
   }
   // fit.glb: the garments by strain, the body by the pressure on the skin.
-  report["legends"] = {{"garment", legend_json(strain_legend())}, {"body", legend_json(pressure_legend(fit))}};
+  report["legends"] = {{"garment", legend_json(strain_legend())},
+                       {"body", legend_json(pressure_legend(fit))}};
   std::filesystem::remove_all(staged);
   write_dress_outputs(staged, body, result, o);
   write_file_atomic(staged / "report.json", report.dump(2));

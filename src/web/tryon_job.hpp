@@ -3,9 +3,8 @@
 // `drape serve --worker-only` process fed through Redis).
 #include <filesystem>
 #include <functional>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "drape/body.hpp"
 #include "drape/dress.hpp"

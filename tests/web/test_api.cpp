@@ -21,9 +21,8 @@ std::string read_bytes(const std::filesystem::path& p) {
 
 httplib::Result upload(httplib::Client& c, const std::string& bytes, const std::string& filename,
                        const std::string& units = "m", const std::string& up = "y") {
-  const httplib::MultipartFormDataItems items{{"file", bytes, filename, "application/octet-stream"},
-                                              {"units", units, "", ""},
-                                              {"up", up, "", ""}};
+  const httplib::MultipartFormDataItems items{
+      {"file", bytes, filename, "application/octet-stream"}, {"units", units, "", ""}, {"up", up, "", ""}};
   return c.Post("/api/bodies", items);
 }
 
@@ -84,7 +83,8 @@ TEST_F(WebApi, CatalogueListsBuiltinsWithSizesFabricAndThumbnail) {
 
 TEST_F(WebApi, BodyFromMeasurements) {
   auto c = server_->client();
-  const auto r = post_json(c, "/api/bodies", {{"sex", "female"}, {"measurements", {{"height", 1.68}, {"bust", 0.9}}}});
+  const auto r =
+      post_json(c, "/api/bodies", {{"sex", "female"}, {"measurements", {{"height", 1.68}, {"bust", 0.9}}}});
   ASSERT_TRUE(r);
   ASSERT_EQ(r->status, 201) << r->body;
   const json j = json_of(r);
@@ -124,6 +124,44 @@ TEST_F(WebApi, BadMeasurementsAreRefusedSayingWhy) {
     EXPECT_NE(e.find(k.says), std::string::npos) << k.body << " -> " << e;
     EXPECT_EQ(e.find("--"), std::string::npos) << "a command-line option in " << e;
   }
+}
+
+TEST_F(WebApi, BodiesAreBounded) {
+  ServeOptions o = quick_serve_options("web_api_bodies");
+  o.max_bodies = 2;
+  TestServer small(o);
+  auto c = small.client();
+  EXPECT_EQ(c.Post("/api/bodies", "{}", "application/json")->status, 201);
+  const std::string second = json_of(c.Post("/api/bodies", "{}", "application/json"))["id"];
+  const auto full = c.Post("/api/bodies", "{}", "application/json");
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->status, 503);
+  EXPECT_FALSE(full->get_header_value("Retry-After").empty());
+  EXPECT_FALSE(error_of(full).empty());
+  // A deleted body makes room.
+  EXPECT_EQ(c.Delete("/api/bodies/" + second)->status, 204);
+  EXPECT_EQ(c.Post("/api/bodies", "{}", "application/json")->status, 201);
+}
+
+TEST_F(WebApi, FindMySizeTriesEverySizeAndRecommendsOne) {
+  auto c = server_->client();
+  const std::string body = json_of(c.Post("/api/bodies", R"({"sex": "female"})", "application/json"))["id"];
+  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "auto"}}.dump(),
+                        "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 202) << r->body;
+  const json t = wait_for_tryon(c, json_of(r)["id"]);
+  ASSERT_EQ(t["state"], "done") << t.dump();
+  const json& advice = t["report"]["size_advice"];
+  ASSERT_TRUE(advice.is_object()) << t["report"].dump();
+  EXPECT_EQ(advice["sizes"].size(), 3u);  // the skirt's S, M and L
+  EXPECT_FALSE(advice["reasons"].empty());
+  // The size shown is the recommended one, or, where none closes and stays on, the chart's.
+  const json recommended = advice["recommended_size"];
+  if (recommended.is_string()) {
+    EXPECT_EQ(t["size"], recommended);
+  }
+  EXPECT_TRUE(t["size"] == "S" || t["size"] == "M" || t["size"] == "L") << t["size"];
 }
 
 TEST_F(WebApi, UploadedBodyIsMeasured) {
@@ -178,7 +216,8 @@ TEST_F(WebApi, BadUploadsAreRefusedSayingWhyWithoutServerPaths) {
   ASSERT_TRUE(no_file);
   EXPECT_EQ(no_file->status, 400);
   // A GLB naming a file on the server's disk for its buffer is refused before anything is read.
-  const std::string gltf_json = R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/etc/hostname","byteLength":4}]})";
+  const std::string gltf_json =
+      R"({"asset":{"version":"2.0"},"buffers":[{"uri":"/etc/hostname","byteLength":4}]})";
   std::string glb = "glTF";
   const auto u32 = [&](uint32_t v) {
     for (int i = 0; i < 4; ++i) glb.push_back(static_cast<char>((v >> (8 * i)) & 255u));
@@ -242,8 +281,9 @@ TEST_F(WebApi, BadTryOnsAndUnknownIds) {
     EXPECT_NE(error_of(r).find(k.says), std::string::npos) << k.request << " -> " << error_of(r);
   }
   for (const std::string& path :
-       {"/api/tryons/" + unknown, std::string("/api/tryons/NOT-AN-ID"), "/api/tryons/" + unknown + "/dressed.glb",
-        "/api/bodies/" + unknown, "/api/bodies/" + unknown + "/body.glb", "/api/bodies/" + body + "/secret.txt",
+       {"/api/tryons/" + unknown, std::string("/api/tryons/NOT-AN-ID"),
+        "/api/tryons/" + unknown + "/dressed.glb", "/api/bodies/" + unknown,
+        "/api/bodies/" + unknown + "/body.glb", "/api/bodies/" + body + "/secret.txt",
         std::string("/api/bodies/..%2F..%2Fetc/body.glb"), std::string("/api/nothing-here")}) {
     const auto r = c.Get(path);
     ASSERT_TRUE(r) << path;
@@ -303,8 +343,8 @@ TEST_F(WebApi, TryOnIsDressedCachedAndDeleted) {
   const auto del = c.Delete("/api/bodies/" + body);
   ASSERT_TRUE(del);
   EXPECT_EQ(del->status, 204);
-  for (const std::string& path : {"/api/bodies/" + body, "/api/bodies/" + body + "/body.glb", "/api/tryons/" + id,
-                                  "/api/tryons/" + id + "/dressed.glb"}) {
+  for (const std::string& path : {"/api/bodies/" + body, "/api/bodies/" + body + "/body.glb",
+                                  "/api/tryons/" + id, "/api/tryons/" + id + "/dressed.glb"}) {
     const auto gone = c.Get(path);
     ASSERT_TRUE(gone);
     EXPECT_EQ(gone->status, 404) << path;

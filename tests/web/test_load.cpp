@@ -25,7 +25,8 @@ TEST(WebLoad, BoundedQueueLosesNothing) {
   std::vector<std::string> bodies;
   {
     auto c = server.client();
-    for (int i = 0; i < kShoppers; ++i) bodies.push_back(json_of(c.Post("/api/bodies", "{}", "application/json"))["id"]);
+    for (int i = 0; i < kShoppers; ++i)
+      bodies.push_back(json_of(c.Post("/api/bodies", "{}", "application/json"))["id"]);
   }
   std::atomic<bool> watching{true};
   std::atomic<int> max_queued{0}, max_running{0};

@@ -30,7 +30,8 @@ TEST(WebIds, AreRandom128BitHex) {
     const std::string id = web::random_id();
     ASSERT_TRUE(web::is_id(id)) << id;
     ids.insert(id);
-    for (size_t k = 0; k < id.size(); ++k) ++counts[k][static_cast<size_t>(std::stoi(id.substr(k, 1), nullptr, 16))];
+    for (size_t k = 0; k < id.size(); ++k)
+      ++counts[k][static_cast<size_t>(std::stoi(id.substr(k, 1), nullptr, 16))];
   }
   EXPECT_EQ(ids.size(), 4000u);
   for (size_t k = 0; k < 32; ++k) {
@@ -51,8 +52,9 @@ TEST(WebPrivacy, BodiesAreNeverListedAndPathsStayInside) {
   std::set<std::string> ids;
   for (int i = 0; i < 5; ++i) ids.insert(json_of(c.Post("/api/bodies", "{}", "application/json"))["id"]);
   EXPECT_EQ(ids.size(), 5u);
-  for (const char* path : {"/api/bodies", "/api/bodies/", "/api/tryons", "/static/", "/static/../../CMakeLists.txt",
-                                 "/three/build/../../../package.json", "/static/%2e%2e/%2e%2e/CMakeLists.txt"}) {
+  for (const char* path :
+       {"/api/bodies", "/api/bodies/", "/api/tryons", "/static/", "/static/../../CMakeLists.txt",
+        "/three/build/../../../package.json", "/static/%2e%2e/%2e%2e/CMakeLists.txt"}) {
     const auto r = c.Get(path);
     ASSERT_TRUE(r) << path;
     EXPECT_GE(r->status, 400) << path;
@@ -71,7 +73,8 @@ TEST(WebPrivacy, DeleteRemovesEveryFileOfABodyAndItsTryOns) {
   TestServer server(quick_serve_options("web_privacy_delete"));
   auto c = server.client();
   const std::string body = json_of(c.Post("/api/bodies", R"({"sex": "male"})", "application/json"))["id"];
-  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "S"}}.dump(), "application/json");
+  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "S"}}.dump(),
+                        "application/json");
   ASSERT_TRUE(r);
   const std::string tryon = json_of(r)["id"];
   ASSERT_EQ(wait_for_tryon(c, tryon)["state"], "done");
@@ -87,7 +90,8 @@ TEST(WebPrivacy, DeletedWhileDressingLeavesNothingBehind) {
   TestServer server(quick_serve_options("web_privacy_running"));
   auto c = server.client();
   const std::string body = json_of(c.Post("/api/bodies", "{}", "application/json"))["id"];
-  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "L"}}.dump(), "application/json");
+  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "L"}}.dump(),
+                        "application/json");
   ASSERT_TRUE(r);
   const std::string tryon = json_of(r)["id"];
   // Deleted while a worker dresses it.
@@ -115,7 +119,8 @@ TEST(WebPrivacy, BodiesExpire) {
   const std::string body = json_of(c.Post("/api/bodies", "{}", "application/json"))["id"];
   EXPECT_EQ(c.Get("/api/bodies/" + body)->status, 200);
   const auto start = std::chrono::steady_clock::now();
-  while (c.Get("/api/bodies/" + body)->status == 200 && std::chrono::steady_clock::now() - start < std::chrono::seconds(20))
+  while (c.Get("/api/bodies/" + body)->status == 200 &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(20))
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   EXPECT_EQ(c.Get("/api/bodies/" + body)->status, 404);
   EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(300));

@@ -75,8 +75,9 @@ class WebRedis : public ::testing::Test {
     end(redis_pid_, SIGTERM);
   }
   pid_t worker(const std::string& tag, const std::vector<std::string>& extra) {
-    std::vector<std::string> args{DRAPE_BINARY, "serve", "--worker-only", "--queue", url_, "--workers", "1",
-                                  "--lease", "1s", "--data", temp_dir(tag).string()};
+    std::vector<std::string> args{DRAPE_BINARY,          "serve", "--worker-only", "--queue", url_,
+                                  "--workers",           "1",     "--lease",       "1s",      "--data",
+                                  temp_dir(tag).string()};
     args.insert(args.end(), extra.begin(), extra.end());
     return spawn(args);
   }
@@ -94,7 +95,8 @@ TEST_F(WebRedis, AWorkerKilledMidJobHasItsTryOnTakenUpByAnother) {
   auto c = server.client();
   const std::string body = json_of(c.Post("/api/bodies", "{}", "application/json"))["id"];
   EXPECT_EQ(connection_->command({"EXISTS", "drape:body:" + body}).value, "1");
-  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "shirt"}, {"size", "M"}}.dump(), "application/json");
+  const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "shirt"}, {"size", "M"}}.dump(),
+                        "application/json");
   ASSERT_TRUE(r);
   ASSERT_EQ(r->status, 202) << r->body;
   const std::string id = json_of(r)["id"];
@@ -139,7 +141,8 @@ TEST_F(WebRedis, ServerWorkersTakeTryOnsFromRedisAndTheQueueStaysBounded) {
   int turned_away = 0;
   for (const char* size : {"S", "M", "L", "XL"}) {
     const std::string body = json_of(c.Post("/api/bodies", "{}", "application/json"))["id"];
-    const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "shirt"}, {"size", size}}.dump(), "application/json");
+    const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "shirt"}, {"size", size}}.dump(),
+                          "application/json");
     ASSERT_TRUE(r);
     if (r->status == 503) {
       ++turned_away;
@@ -153,7 +156,8 @@ TEST_F(WebRedis, ServerWorkersTakeTryOnsFromRedisAndTheQueueStaysBounded) {
   EXPECT_GE(turned_away, 1);
   for (const std::string& id : accepted) {
     const json t = wait_for_tryon(c, id, std::chrono::seconds(300));
-    EXPECT_TRUE(t["state"] == "done" || (t["state"] == "failed" && !t["error"].get<std::string>().empty())) << t.dump();
+    EXPECT_TRUE(t["state"] == "done" || (t["state"] == "failed" && !t["error"].get<std::string>().empty()))
+        << t.dump();
   }
   EXPECT_EQ(json_of(c.Get("/api/health"))["tryons"]["done"].get<size_t>(), accepted.size());
 }

@@ -7,16 +7,13 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
 
-#include <nlohmann/json.hpp>
-
 #include "drape/web.hpp"
 #include "support/test_support.hpp"
-// After the Eigen headers: glibc's <resolv.h>, which httplib includes, defines a macro `_res` that
-// Eigen's products use as a parameter name.
-#include <httplib.h>
+#include "web/http.hpp"
 
 namespace drape::test {
 

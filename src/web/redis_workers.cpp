@@ -13,6 +13,7 @@
 #include "web/ids.hpp"
 #include "web/redis_queue.hpp"
 #include "web/request_error.hpp"
+#include "web/service.hpp"
 #include "web/tryon_job.hpp"
 
 namespace drape::web {
@@ -126,8 +127,7 @@ void RedisWorkers::work(const std::string& worker) {
       std::fprintf(stderr, "drape serve: a try-on failed: %s\n", e.what());
       result.error = "the dressing failed on the server; please try again or pick another size";
     }
-    std::error_code ec;
-    std::filesystem::remove_all(staged, ec);
+    remove_inside(options_.data_dir / "work", staged);
     try {
       redis->finish(worker, *job, result, options_.keep);
     } catch (const std::exception& e) {

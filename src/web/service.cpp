@@ -24,13 +24,30 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+}  // namespace
+
+void remove_inside(const std::filesystem::path& root, const std::filesystem::path& target) {
+  // Every folder the service removes is a body's or a try-on's, strictly inside the data folder;
+  // anything else is refused here, whatever a caller computed.
+  const std::filesystem::path rel = target.lexically_normal().lexically_relative(root.lexically_normal());
+  if (rel.empty() || rel == "." || *rel.begin() == ".." || rel.is_absolute()) {
+    std::fprintf(stderr, "drape serve: refused to remove '%s': not inside the data folder\n", target.string().c_str());
+    return;
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(target, ec);
+  if (ec) std::fprintf(stderr, "drape serve: could not remove files of a body or try-on: %s\n", ec.message().c_str());
+}
+
+namespace {
+
 // Removes what a previous run left: the bodies it held in memory are gone, so their files could
 // never be reached or deleted through the API again.
 void clear_unreachable(const std::filesystem::path& dir) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-    if (is_id(entry.path().filename().string())) std::filesystem::remove_all(entry.path(), ec);
+    if (is_id(entry.path().filename().string())) remove_inside(dir, entry.path());
 }
 
 }  // namespace
@@ -96,7 +113,10 @@ void TryOnService::stop() {
   // Bodies live in this process's memory: once it stops, their files could never be reached or
   // deleted through the API, so they go now.
   std::lock_guard lock(mutex_);
-  while (!bodies_.empty()) remove_body_locked(bodies_.begin()->first);
+  while (!bodies_.empty()) {
+    const std::string id = bodies_.begin()->first;  // a copy: the map's own key dies with the entry
+    remove_body_locked(id);
+  }
 }
 
 std::filesystem::path TryOnService::body_dir(const std::string& id) const {
@@ -141,7 +161,10 @@ std::optional<std::filesystem::path> TryOnService::body_file(const std::string& 
   return body_dir(id) / name;
 }
 
-void TryOnService::remove_body_locked(const std::string& id) {
+void TryOnService::remove_body_locked(const std::string& id_in) {
+  // By value: `id_in` may be a key of bodies_ (or of something erased below), which erase() frees.
+  const std::string id = id_in;
+  if (!is_id(id)) return;  // never a path built from anything else
   const auto it = bodies_.find(id);
   if (it == bodies_.end()) return;
   for (const std::string& t : it->second.tryons) {
@@ -154,9 +177,7 @@ void TryOnService::remove_body_locked(const std::string& id) {
   }
   if (redis_) redis_try([&] { redis_->delete_body(id); });
   bodies_.erase(it);
-  std::error_code ec;
-  std::filesystem::remove_all(body_dir(id), ec);
-  if (ec) std::fprintf(stderr, "drape serve: could not remove a body's files: %s\n", ec.message().c_str());
+  remove_inside(options_.data_dir / "bodies", body_dir(id));
 }
 
 bool TryOnService::delete_body(const std::string& id) {
@@ -300,12 +321,12 @@ void TryOnService::finish(const std::string& id, TryOnState state, const std::st
   std::lock_guard lock(mutex_);
   const auto it = tryons_.find(id);
   if (it == tryons_.end()) {  // deleted or expired meanwhile: nothing of it may stay
-    std::filesystem::remove_all(staged, ec);
+    remove_inside(options_.data_dir / "work", staged);
     return;
   }
   TryOnView& view = it->second.view;
   if (view.state == TryOnState::Done || view.state == TryOnState::Failed) {  // answered twice: keep the first
-    std::filesystem::remove_all(staged, ec);
+    remove_inside(options_.data_dir / "work", staged);
     return;
   }
   if (state == TryOnState::Done) {
@@ -317,7 +338,7 @@ void TryOnService::finish(const std::string& id, TryOnState state, const std::st
       state = TryOnState::Failed;
     }
   }
-  std::filesystem::remove_all(staged, ec);
+  remove_inside(options_.data_dir / "work", staged);
   view.state = state;
   if (state == TryOnState::Done) {
     view.progress = 1.0;
@@ -356,7 +377,7 @@ void TryOnService::collector_loop() {
         const std::optional<RedisResult> result = redis->take_result(*done);
         if (result && is_id(result->tryon)) {
           const std::filesystem::path staged = options_.data_dir / "work" / result->tryon;
-          std::filesystem::remove_all(staged);
+          remove_inside(options_.data_dir / "work", staged);
           for (const auto& [name, bytes] : result->files)
             if (std::find(std::begin(kTryOnFiles), std::end(kTryOnFiles), name) != std::end(kTryOnFiles))
               write_file_atomic(staged / name, bytes);

@@ -29,6 +29,10 @@
 
 namespace drape::web {
 
+// Removes `target` (a folder) when it lies strictly inside `root`; anything else is refused and named
+// on stderr. Every removal of the service goes through it.
+void remove_inside(const std::filesystem::path& root, const std::filesystem::path& target);
+
 enum class TryOnState { Queued, Running, Done, Failed };
 const char* to_string(TryOnState state);
 

@@ -2,10 +2,12 @@
 // expiry remove every file of a body and its try-ons; nothing reaches outside the data folder.
 #include <array>
 #include <cmath>
+#include <fstream>
 #include <set>
 
 #include "drape/error.hpp"
 #include "web/ids.hpp"
+#include "web/service.hpp"
 #include "web/web_fixture.hpp"
 
 namespace drape::test {
@@ -109,6 +111,42 @@ TEST(WebPrivacy, DeletedWhileDressingLeavesNothingBehind) {
   EXPECT_EQ(c.Get("/api/tryons/" + tryon)->status, 404);
   EXPECT_TRUE(files_naming(server.options.data_dir, body).empty());
   EXPECT_TRUE(files_naming(server.options.data_dir, tryon).empty());
+}
+
+TEST(WebPrivacy, StoppingRemovesTheBodiesItHeldAndNothingElse) {
+  ServeOptions o = quick_serve_options("web_privacy_stop");
+  // Beside the data folder and inside it: files the server must leave alone.
+  const std::filesystem::path beside = o.data_dir.parent_path() / "web_privacy_stop_neighbour.txt";
+  std::ofstream(beside) << "keep";
+  std::filesystem::create_directories(o.data_dir / "kept");
+  std::ofstream(o.data_dir / "kept" / "note.txt") << "keep";
+  std::vector<std::string> ids;
+  {
+    TestServer server(o);
+    auto c = server.client();
+    for (int i = 0; i < 4; ++i) ids.push_back(json_of(c.Post("/api/bodies", "{}", "application/json"))["id"]);
+    for (const std::string& id : ids) EXPECT_FALSE(files_naming(o.data_dir, id).empty());
+  }
+  for (const std::string& id : ids) EXPECT_TRUE(files_naming(o.data_dir, id).empty()) << id;
+  EXPECT_TRUE(std::filesystem::exists(beside));
+  EXPECT_TRUE(std::filesystem::exists(o.data_dir / "kept" / "note.txt"));
+  EXPECT_TRUE(std::filesystem::is_directory(o.data_dir / "bodies"));
+  std::filesystem::remove(beside);
+}
+
+TEST(WebPrivacy, RemovalsStayInsideTheDataFolder) {
+  const std::filesystem::path root = temp_dir("web_privacy_inside");
+  const std::filesystem::path outside = root.parent_path() / "web_privacy_inside_outside";
+  std::filesystem::create_directories(outside);
+  std::filesystem::create_directories(root / "bodies" / "x");
+  for (const std::filesystem::path& target : {outside, root, root / "..", root / "bodies" / ".." / "..",
+                                              std::filesystem::path("/"), std::filesystem::path{}})
+    web::remove_inside(root, target);
+  EXPECT_TRUE(std::filesystem::is_directory(outside));
+  EXPECT_TRUE(std::filesystem::is_directory(root / "bodies" / "x"));
+  web::remove_inside(root, root / "bodies" / "x");
+  EXPECT_FALSE(std::filesystem::exists(root / "bodies" / "x"));
+  std::filesystem::remove_all(outside);
 }
 
 TEST(WebPrivacy, BodiesExpire) {

@@ -1,9 +1,11 @@
 // The JSON API, endpoint by endpoint, with good and bad input: every answer has the right status
 // and a message that says what is wrong (never a server path), and the server keeps serving.
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
 #include "drape/body.hpp"
+#include "drape/error.hpp"
 #include "drape/io.hpp"
 #include "web/web_fixture.hpp"
 
@@ -79,6 +81,32 @@ TEST_F(WebApi, CatalogueListsBuiltinsWithSizesFabricAndThumbnail) {
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->status, 404);
   EXPECT_FALSE(error_of(missing).empty());
+}
+
+TEST(WebCatalogue, GarmentFilesOfTheCatalogueFolderAreOffered) {
+  ServeOptions o = quick_serve_options("web_catalogue");
+  o.catalogue_dir = temp_dir("web_catalogue_files");
+  const std::filesystem::path assets = std::filesystem::path(DRAPE_SOURCE_DIR) / "assets" / "garments";
+  std::filesystem::copy_file(assets / "skirt.json", o.catalogue_dir / "pencil-skirt.json");
+  std::ofstream(o.catalogue_dir / "broken.json") << "{ not a garment";
+  std::filesystem::copy_file(assets / "skirt.json", o.catalogue_dir / "Bad Name.json");
+  TestServer server(o);
+  auto c = server.client();
+  const json list = json_of(c.Get("/api/garments"))["garments"];
+  std::vector<std::string> names;
+  for (const json& g : list) names.push_back(g["name"]);
+  EXPECT_NE(std::find(names.begin(), names.end(), "pencil-skirt"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "shirt"), names.end());
+  EXPECT_EQ(std::find(names.begin(), names.end(), "broken"), names.end());
+  EXPECT_EQ(std::find(names.begin(), names.end(), "Bad Name"), names.end());
+  const auto png = c.Get("/api/garments/pencil-skirt/thumbnail.png");
+  ASSERT_TRUE(png);
+  EXPECT_EQ(png->status, 200);
+  EXPECT_EQ(png->body.substr(1, 3), "PNG");
+  // A missing catalogue folder is an error the command reports.
+  ServeOptions missing = quick_serve_options("web_catalogue_missing");
+  missing.catalogue_dir = missing.data_dir / "no-such-folder";
+  EXPECT_THROW(WebServer{missing}, InputError);
 }
 
 TEST_F(WebApi, BodyFromMeasurements) {

@@ -33,7 +33,8 @@ struct ServeOptions {
   std::chrono::milliseconds keep{std::chrono::hours(24)};  // a body and its try-ons live this long
   size_t max_upload_bytes = 64u << 20;                     // a larger request is refused (413)
   size_t max_upload_triangles = 2'000'000;
-  size_t max_bodies = 10'000;                      // bodies held at once; more are refused (503) until some expire                 // a body mesh with more is refused (413)
+  size_t max_bodies = 10'000;  // bodies held at once; more are refused (503) until some expire // a body mesh
+                               // with more is refused (413)
   DressOptions dress;  // how try-ons are dressed (mesh edge, iteration cap, ...)
   // Shared queue: "redis://HOST:PORT" sends try-ons through Redis, where this server's workers and
   // `drape serve --worker-only` processes take them; empty: the in-process queue. A worker that

@@ -31,12 +31,15 @@ void remove_inside(const std::filesystem::path& root, const std::filesystem::pat
   // anything else is refused here, whatever a caller computed.
   const std::filesystem::path rel = target.lexically_normal().lexically_relative(root.lexically_normal());
   if (rel.empty() || rel == "." || *rel.begin() == ".." || rel.is_absolute()) {
-    std::fprintf(stderr, "drape serve: refused to remove '%s': not inside the data folder\n", target.string().c_str());
+    std::fprintf(stderr, "drape serve: refused to remove '%s': not inside the data folder\n",
+                 target.string().c_str());
     return;
   }
   std::error_code ec;
   std::filesystem::remove_all(target, ec);
-  if (ec) std::fprintf(stderr, "drape serve: could not remove files of a body or try-on: %s\n", ec.message().c_str());
+  if (ec)
+    std::fprintf(stderr, "drape serve: could not remove files of a body or try-on: %s\n",
+                 ec.message().c_str());
 }
 
 namespace {

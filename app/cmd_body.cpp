@@ -17,7 +17,6 @@ struct BodyArgs {
   std::string sex = "female";
   std::string measurements;
   std::string out = "body.glb";
-  float grid = 0.011f;
   std::string skeleton = "drape";
 };
 
@@ -25,12 +24,11 @@ void run_body(const BodyArgs& args) {
   const Sex sex = args.sex == "male" ? Sex::Male : Sex::Female;
   const MeasurementRequest request = args.measurements.empty() ? MeasurementRequest{} : parse_measurements(args.measurements);
   BodyBuildOptions options;
-  options.grid_step = args.grid;
   options.skeleton = args.skeleton == "cmu_mb" ? BodySkeleton::CmuMb : BodySkeleton::Drape;
-  // No measurements: the built-in body, baked into the binary at the default grid, made now at another.
-  const Body body = !request.empty()                               ? make_human_body(sex, request, options)
-                    : options.grid_step != BodyBuildOptions{}.grid_step ? generate_default_body(sex, options)
-                                                                   : default_body(sex);
+  // No measurements: the built-in average adult (its shape baked into the binary), rigged as asked.
+  const Body body = !request.empty()                       ? make_human_body(sex, request, options)
+                    : options.skeleton == BodySkeleton::Drape ? default_body(sex)
+                                                              : make_human_body(sex, default_body_request(sex), options);
   write_scene(args.out, body_scene(body));
 
   nlohmann::json j;
@@ -78,9 +76,6 @@ void add_body_command(CLI::App& app) {
                   "joints) or cmu_mb (MakeHuman's 31-joint CMU motion-builder skeleton)")
       ->check(CLI::IsMember({"drape", "cmu_mb"}))
       ->default_val("drape");
-  cmd->add_option("--grid", args->grid, "The built-in body (no --measurements) made now at this polygonisation step, metres")
-      ->check(CLI::Range(0.005f, 0.03f))
-      ->default_val(0.011f);
   cmd->callback([args] { run_body(*args); });
 }
 

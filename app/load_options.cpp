@@ -19,7 +19,7 @@ Body load_command_body(const std::string& body, const std::string& measurements,
   if (!measurements.empty()) {
     if (body != "female" && body != "male")
       throw InputError("--measurements", "goes with --body female or male, not a body file");
-    return make_body(body == "male" ? Sex::Male : Sex::Female, parse_measurements(measurements));
+    return make_human_body(body == "male" ? Sex::Male : Sex::Female, parse_measurements(measurements));
   }
   if (body == "female" || body == "male") return default_body(body == "male" ? Sex::Male : Sex::Female);
   if (!std::filesystem::exists(body)) throw InputError(body, "no such body file (or use --body female|male)");

@@ -1,7 +1,7 @@
-// Build step: makes the default female and male bodies with the generator and writes their meshes
-// to the file named on the command line (body/baked.hpp's format), which the build then compiles
-// into drape_default_bodies. Generating them takes ~1.1 s each; done here, `drape dress` and every
-// other use of a default body skips it.
+// Build step: solves for the MakeHuman shapes of the default female and male bodies (the average
+// adult of each sex) and writes them to the file named on the command line (body/baked.hpp's
+// format), which the build then compiles into drape_default_bodies. The solve takes ~1 s a body;
+// done here, `drape dress` and every other use of a default body only builds the body from it.
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -15,10 +15,10 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    std::vector<drape::body::BakedBody> bodies;
+    std::vector<drape::body::MhShape> shapes;
     for (const drape::Sex sex : {drape::Sex::Female, drape::Sex::Male})
-      bodies.push_back({sex, drape::generate_default_body(sex).mesh});
-    const std::string bytes = drape::body::encode_baked_bodies(bodies);
+      shapes.push_back(drape::body::solve_human_shape(sex, drape::default_body_request(sex)));
+    const std::string bytes = drape::body::encode_baked_shapes(shapes);
     const std::filesystem::path out = argv[1];
     const std::filesystem::path tmp = out.string() + ".tmp";
     {

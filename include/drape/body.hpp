@@ -151,16 +151,20 @@ Body make_human_body(Sex sex, const MeasurementRequest& request, const BodyBuild
 // InputError("--measurements") when the request is not self-consistent enough to build.
 Body make_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options = {});
 
-// The built-in average adult female (1.65 m) and male (1.78 m). Their meshes are made by
-// generate_default_body when drape is built and compiled into the binary (src/default_bodies), so
-// this only analyses and rigs them: ~0.1 s instead of ~1.1 s. Defined in drape_default_bodies.
+// The built-in average adult female (1.65 m) and male (1.78 m): make_human_body on
+// default_body_request. Their shapes are solved for when drape is built and compiled into the
+// binary (src/default_bodies), so this only builds, analyses and rigs the body, once per process
+// and sex. Defined in drape_default_bodies.
 Body default_body(Sex sex);
-// The same body made now by the generator: make_body on the average measurements (what the build
-// runs; bit for bit the body default_body returns when built with the same compiler and flags).
-// Other options (a finer grid) give the default body at another resolution.
+// The average adult of that sex (default_measurements) without shoulder width and back length,
+// which follow from the shape: what the default bodies are made to.
+MeasurementRequest default_body_request(Sex sex);
+// The generator's average adult: make_body on default_body_request. Options (a finer grid) give it
+// at another resolution (the benchmarks' fine body).
 Body generate_default_body(Sex sex, const BodyBuildOptions& options = {});
-// The generator's last step, on the mesh it settled on (or that mesh baked): named, analysed, rigged.
+// The generator's last step, on the mesh it settled on: named, analysed, rigged.
 Body finish_generated_body(Sex sex, Mesh mesh);
+// Average measurements of an adult of that sex, every key.
 MeasurementRequest default_measurements(Sex sex);
 
 // ---- Bodies from files --------------------------------------------------------------------------

@@ -1,24 +1,20 @@
 #pragma once
-// The default bodies' meshes as the build bakes them into the binary (src/default_bodies): the
-// generator's output, before analysis and rig, which are cheap and run when a body is asked for.
-// Format (native byte order: written and read by builds of the same machine): "DRAPEBB1", a
-// uint32 body count, then per body uint32 sex (0 female, 1 male), vertex count and triangle count,
-// float positions[3 n], float normals[3 n], uint32 triangles[3 t].
+// The default bodies as the build bakes them into the binary (src/default_bodies): the MakeHuman
+// shape that measures as the average adult of each sex (solving for it is the slow part of making
+// a body, ~1 s); building the body from the shape, analysing and rigging it run when a body is
+// asked for. Format (native byte order: written and read by builds of the same machine):
+// "DRAPEBB2", a uint32 body count, then per body uint32 sex (0 female, 1 male), float weight,
+// height and scale, a uint32 count of measurement targets and their floats.
 #include <span>
 #include <string>
 #include <vector>
 
-#include "drape/body.hpp"
+#include "body/makehuman.hpp"
 
 namespace drape::body {
 
-struct BakedBody {
-  Sex sex = Sex::Female;
-  Mesh mesh;  // positions, normals, triangles
-};
-
-std::string encode_baked_bodies(const std::vector<BakedBody>& bodies);
+std::string encode_baked_shapes(const std::vector<MhShape>& shapes);
 // std::runtime_error when the bytes are not a well-formed bake or hold no body of this sex.
-Mesh decode_baked_body(std::span<const unsigned char> bytes, Sex sex);
+MhShape decode_baked_shape(std::span<const unsigned char> bytes, Sex sex);
 
 }  // namespace drape::body

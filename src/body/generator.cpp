@@ -488,11 +488,7 @@ Body finish_generated_body(Sex sex, Mesh mesh) {
 }
 
 Body generate_default_body(Sex sex, const BodyBuildOptions& options) {
-  // Everything but shoulder width and back length, which follow from the chest and the height.
-  MeasurementRequest request = average(sex);
-  request.erase("shoulder_width");
-  request.erase("back_length");
-  return make_body(sex, request, options);
+  return make_body(sex, default_body_request(sex), options);
 }
 
 }  // namespace drape

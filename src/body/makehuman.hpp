@@ -85,4 +85,9 @@ size_t untangle(Mesh& mesh, int max_rounds = 40);
 // the chosen skeleton placed on it (joints at the means of their vertex groups) and its skin weights.
 Body mh_body(const MhShape& shape, BodySkeleton skeleton = BodySkeleton::Drape);
 
+// The shape whose body measures as requested (make_human_body's solve: the weight and height macros
+// and one measurement target per requested key; docs/bodies.md). InputError("measurements") for a
+// combination no human body has.
+MhShape solve_human_shape(Sex sex, const MeasurementRequest& request);
+
 }  // namespace drape::body

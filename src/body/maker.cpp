@@ -172,7 +172,7 @@ Body body::mh_body(const MhShape& shape, BodySkeleton skeleton) {
   return b;
 }
 
-Body make_human_body(Sex sex, const MeasurementRequest& given, const BodyBuildOptions& options) {
+body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) {
   const MhModel& model = body::makehuman_model();
   // Height is always fitted (the average adult's when not given); other keys only when given.
   MeasurementRequest request = given;
@@ -349,7 +349,18 @@ Body make_human_body(Sex sex, const MeasurementRequest& given, const BodyBuildOp
     }
     if (!better) break;
   }
-  return body::mh_body(shape_at(best_x), options.skeleton);
+  return shape_at(best_x);
+}
+
+MeasurementRequest default_body_request(Sex sex) {
+  MeasurementRequest request = default_measurements(sex);
+  request.erase("shoulder_width");
+  request.erase("back_length");
+  return request;
+}
+
+Body make_human_body(Sex sex, const MeasurementRequest& request, const BodyBuildOptions& options) {
+  return body::mh_body(body::solve_human_shape(sex, request), options.skeleton);
 }
 
 }  // namespace drape

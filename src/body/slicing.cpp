@@ -59,10 +59,10 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
   auto side = [&](uint32_t v) { return (p[v] - plane.origin).dot(plane.normal); };
 
   // Each crossing edge gives one point, shared by the two triangles on it. Edges are collected in
-  // the order met (two per cut triangle), then sorted by key to find each edge's first meeting:
-  // points are numbered in that order, as a hash map keyed by edge would number them.
-  std::vector<std::pair<uint64_t, uint32_t>> edges;  // (edge key, order met)
-  std::vector<std::array<uint32_t, 2>> edge_ends;    // per order met: the edge's vertices
+  // the order met (two per cut triangle); a table keyed by edge finds each edge's first meeting,
+  // and points are numbered in that order, whatever the table's layout.
+  std::vector<uint64_t> edges;                     // per order met: the edge's key
+  std::vector<std::array<uint32_t, 2>> edge_ends;  // per order met: the edge's vertices
   edges.reserve(512);
   edge_ends.reserve(512);
   auto cut = [&](const Tri& t) {
@@ -73,7 +73,7 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
       if (below[e] != below[(e + 1) % 3]) {
         uint32_t a = t[e], c = t[(e + 1) % 3];
         if (a > c) std::swap(a, c);
-        edges.emplace_back((uint64_t{a} << 32) | c, static_cast<uint32_t>(edges.size()));
+        edges.push_back((uint64_t{a} << 32) | c);
         edge_ends.push_back({a, c});
       }
   };
@@ -89,15 +89,24 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
       if (signs != 0 && signs != 7) cut(t);
     }
   }
-  // First meeting of each edge, and the points numbered by first meeting.
+  // First meeting of each edge (open addressing, linear probing; a sort of the keys costs several
+  // times more, and slicing is most of what measuring a body costs).
   const size_t met = edges.size();
-  std::vector<std::pair<uint64_t, uint32_t>> sorted = edges;
-  std::sort(sorted.begin(), sorted.end());
+  size_t capacity = 64;
+  while (capacity < 2 * met) capacity *= 2;
+  constexpr uint64_t kEmpty = ~uint64_t{0};  // no edge: vertex indices are below 2^32 - 1
+  std::vector<uint64_t> slot_key(capacity, kEmpty);
+  std::vector<uint32_t> slot_first(capacity);
   std::vector<uint32_t> first(met);  // per order met: the order its edge was first met
-  for (size_t i = 0; i < met;) {
-    size_t j = i;
-    while (j < met && sorted[j].first == sorted[i].first) first[sorted[j++].second] = sorted[i].second;
-    i = j;
+  for (uint32_t i = 0; i < met; ++i) {
+    const uint64_t key = edges[i];
+    size_t h = static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> 32) & (capacity - 1);
+    while (slot_key[h] != kEmpty && slot_key[h] != key) h = (h + 1) & (capacity - 1);
+    if (slot_key[h] == kEmpty) {
+      slot_key[h] = key;
+      slot_first[h] = i;
+    }
+    first[i] = slot_first[h];
   }
   std::vector<uint32_t> point_of(met, 0);
   std::vector<Vec2f> points;

@@ -1,7 +1,6 @@
 // The default bodies, baked into the binary when drape is built (tools/bake_default_bodies.cpp
-// writes the generator's meshes; .incbin puts the file in .rodata: a C array literal of ~2 MB
-// would cost the compiler far more). Analysis and rig run on load: they are cheap (~0.1 s) and
-// keep the bake down to meshes.
+// writes their MakeHuman shapes; .incbin puts the file in .rodata). The body is built from its
+// shape, analysed and rigged on load, once per process and sex.
 #include <span>
 
 #include "body/baked.hpp"
@@ -28,8 +27,18 @@ extern "C" const unsigned char drape_baked_bodies_end[];
 namespace drape {
 
 Body default_body(Sex sex) {
-  const std::span<const unsigned char> bytes(drape_baked_bodies_begin, drape_baked_bodies_end);
-  return finish_generated_body(sex, body::decode_baked_body(bytes, sex));
+  // Built once per sex (thread-safe statics) and copied out: dressing tests and `drape fit` ask
+  // for the same body many times.
+  const auto build = [](Sex s) {
+    const std::span<const unsigned char> bytes(drape_baked_bodies_begin, drape_baked_bodies_end);
+    return body::mh_body(body::decode_baked_shape(bytes, s));
+  };
+  if (sex == Sex::Male) {
+    static const Body male = build(Sex::Male);
+    return male;
+  }
+  static const Body female = build(Sex::Female);
+  return female;
 }
 
 }  // namespace drape

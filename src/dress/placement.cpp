@@ -21,6 +21,7 @@
 #include <string>
 #include <numbers>
 
+#include "body/analysis.hpp"
 #include "dress/stages.hpp"
 #include "drape/error.hpp"
 
@@ -383,41 +384,40 @@ bool spans_hips(const PlacementHint& h) {
          (h.landmark == Landmark::waist || h.landmark == Landmark::hip || h.landmark == Landmark::crotch);
 }
 
-// How far below the waist a garment's waistband sits: where the body's girth (the ellipse around
-// its torso section, arms left out) first reaches the band's girth less 2 cm, at most 15 cm down.
-// The band is the top 3 cm of every panel (a back panel's top rises towards the centre), side by side.
-float waistband_drop(const Body& body, const Garment& garment, const GarmentMesh& mesh, const std::vector<size_t>& panels) {
-  constexpr float kBand = 0.03f, kEase = 0.02f, kMaxDrop = 0.15f;
+// How far below where it was placed a skirt's or trousers' waistband sits (its top at height
+// `top`): where the body's tape girth (the convex hull of its torso section) first reaches the
+// band's girth less 2 cm, a little above where the garment would come to rest on a person (so it
+// settles onto the body there rather than starting stretched round it), and at most down to the
+// fullest hip section. The band is the top 3 cm of every panel (a back panel's top rises towards the centre),
+// side by side. 0 unless every panel hangs from the waist.
+float waistband_drop(const Body& body, const Garment& garment, const GarmentMesh& mesh, const std::vector<size_t>& panels,
+                     float top) {
+  constexpr float kBand = 0.03f, kEase = 0.02f;
+  if (!garment.bands.empty()) return 0.0f;  // an elastic waistband holds it where it is placed
   float band = 0;
   for (size_t p : panels) {
+    // Panels hung from their waistline; trousers hung from the crotch or the hips keep their
+    // anchor, where their crotch seam meets the body's.
     if (garment.panels[p].placement->landmark != Landmark::waist) return 0.0f;
     const auto& q = mesh.panels[p].mesh.positions;
-    float top = -std::numeric_limits<float>::max();
-    for (const Vec3f& v : q) top = std::max(top, v.y());
+    float panel_top = -std::numeric_limits<float>::max();
+    for (const Vec3f& v : q) panel_top = std::max(panel_top, v.y());
     float lo = std::numeric_limits<float>::max(), hi = -lo;
     for (const Vec3f& v : q)
-      if (v.y() >= top - kBand) {
+      if (v.y() >= panel_top - kBand) {
         lo = std::min(lo, v.x());
         hi = std::max(hi, v.x());
       }
     band += std::max(0.0f, hi - lo);
   }
-  const float waist = body.landmarks.waist.y();
-  const int steps = static_cast<int>(kMaxDrop / kStation);
-  std::vector<Bounds> section(static_cast<size_t>(steps) + 1);
-  for (size_t i = 0; i < body.mesh.positions.size(); ++i) {
-    const Vec3f& p = body.mesh.positions[i];
-    const int s = static_cast<int>(std::lround((waist - p.y()) / kStation));
-    if (s >= 0 && s <= steps && in_region(body.parts[i], BodyRegion::torso)) section[static_cast<size_t>(s)].extend(p);
-  }
-  for (int s = 0; s <= steps; ++s) {
-    const Bounds& b = section[static_cast<size_t>(s)];
-    if (b.empty()) continue;
-    const float a = 0.5f * b.size().x(), c = 0.5f * b.size().z();
-    const float girth = kPi * (3 * (a + c) - std::sqrt((3 * a + c) * (a + 3 * c)));  // Ramanujan
-    if (girth >= band - kEase) return kStation * static_cast<float>(s);
-  }
-  return kMaxDrop;
+  const float start = top - 0.5f * kBand;  // the middle of the band
+  const float lowest = std::min(start, body.landmarks.hip.y());
+  const body::Slicer slicer(body.mesh);
+  for (float drop = 0; start - drop > lowest; drop += kStation)
+    if (body::torso_girth(slicer, start - drop) >= band - kEase) return drop;
+  // Looser than the hips (or measured so: a flared panel's top is wider than its waist seam):
+  // something else holds it, or nothing does; it starts where the file or the anchor puts it.
+  return 0.0f;
 }
 
 struct RegionPanels {
@@ -471,10 +471,10 @@ void place_region(const Body& body, const Garment& garment, const GarmentMesh& m
   }
   clearance += extra;
 
-  // Trousers looser than the waist sit lower, where the body is as wide as their waistband (as they
-  // would slide down on a person), so they do not drop while draping.
-  if (rp.trousers) {
-    const float drop = waistband_drop(body, garment, mesh, rp.panels);
+  // Skirts and trousers looser than the waist sit lower, where the body is as wide as their
+  // waistband (as they would slide down on a person), so they do not drop while draping.
+  if (rp.trousers || rp.region == BodyRegion::torso) {
+    const float drop = waistband_drop(body, garment, mesh, rp.panels, t_hi);
     for (size_t k = 0; k < rp.panels.size(); ++k) {
       t_anchor[k] -= drop;
       for (float& t : vt[k]) t -= drop;

@@ -83,6 +83,9 @@ PanelTriangulation triangulate_grid(const BoundaryLoop& boundary, const Vec2d& g
   }
   mark_domain(cdt);
   PanelTriangulation tri = collect_triangulation(cdt, std::move(points));
+  // Vertices the triangulation added (where two outline constraints cross) are off the lattice,
+  // like the outline's own: every vertex has its lattice entry.
+  topo.lattice.resize(tri.points.size(), {kOffLattice, kOffLattice});
 
   // Springs along the lattice (never across the outline, e.g. over a dart's gap).
   const auto link = [&](std::vector<std::array<uint32_t, 2>>& out, int64_t a, int64_t b) {

@@ -71,7 +71,7 @@ Body body_from_measurements(const nlohmann::json& request) {
     text += fmt::format("{}{}={}", text.empty() ? "" : ",", key, value.get<double>());
   }
   try {
-    return make_body(sex, parse_measurements(text));
+    return make_human_body(sex, parse_measurements(text));
   } catch (const InputError& e) {
     rethrow_as(e, "measurements");
   }

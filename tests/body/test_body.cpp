@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -393,16 +394,16 @@ TEST(BodyCommand, WritesRiggedGlbAndRefusesBadMeasurements) {
   EXPECT_EQ(nlohmann::json::parse(cmu.out)["joints"].get<size_t>(), 31u);
   EXPECT_GE(read_scene(dir / "cmu.glb").find_node("LHipJoint"), 0);
 
-  // The default body at another grid is made now (the baked one is at the default grid): a coarser
-  // grid, fewer triangles, the same average adult.
+  // No measurements: the built-in average adult; with the cmu_mb skeleton, the same body made now.
   const auto plain = drape::test::run_drape("body -o " + (dir / "plain.glb").string());
-  const auto coarse = drape::test::run_drape("body --grid 0.02 -o " + (dir / "coarse.glb").string());
+  const auto plain_cmu = drape::test::run_drape("body --skeleton cmu_mb -o " + (dir / "plain_cmu.glb").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  ASSERT_EQ(coarse.exit_code, 0) << coarse.err;
-  const auto plain_report = nlohmann::json::parse(plain.out), coarse_report = nlohmann::json::parse(coarse.out);
-  EXPECT_LT(coarse_report["triangles"].get<size_t>(), plain_report["triangles"].get<size_t>() / 2);
-  EXPECT_NEAR(coarse_report["measurements"]["hips"]["measured_m"].get<double>(),
-              plain_report["measurements"]["hips"]["measured_m"].get<double>(), 0.01);
+  ASSERT_EQ(plain_cmu.exit_code, 0) << plain_cmu.err;
+  const auto plain_report = nlohmann::json::parse(plain.out), cmu_report = nlohmann::json::parse(plain_cmu.out);
+  EXPECT_EQ(cmu_report["triangles"].get<size_t>(), plain_report["triangles"].get<size_t>());
+  EXPECT_EQ(cmu_report["joints"].get<size_t>(), 31u);
+  EXPECT_NEAR(cmu_report["measurements"]["hips"]["measured_m"].get<double>(),
+              plain_report["measurements"]["hips"]["measured_m"].get<double>(), 1e-6);
 
   const auto bad = drape::test::run_drape("body --measurements waist=7.4 -o " + (dir / "bad.glb").string());
   EXPECT_EQ(bad.exit_code, 2);
@@ -410,13 +411,15 @@ TEST(BodyCommand, WritesRiggedGlbAndRefusesBadMeasurements) {
   EXPECT_FALSE(std::filesystem::exists(dir / "bad.glb"));
 }
 
-// The default bodies are baked into the binary at build time (src/default_bodies): what
-// default_body returns must be what the generator makes, bit for bit, analysis and rig included.
-TEST(DefaultBodies, BakedBodyIsTheGeneratorsBody) {
-  if (sanitized()) GTEST_SKIP() << "slow under sanitizers (the generator polygonises several times)";
+// The default bodies' shapes are baked into the binary at build time (src/default_bodies): what
+// default_body returns must be the body make_human_body makes now, bit for bit, analysis and rig
+// included, and it must measure as requested.
+TEST(DefaultBodies, BakedBodyIsTheMadeBody) {
+  if (sanitized()) GTEST_SKIP() << "slow under sanitizers (the shape is solved for anew)";
   for (const Sex sex : {Sex::Female, Sex::Male}) {
     const Body baked = default_body(sex);
-    const Body made = generate_default_body(sex);
+    const MeasurementRequest request = default_body_request(sex);
+    const Body made = make_human_body(sex, request);
     const char* who = sex == Sex::Female ? "female" : "male";
     ASSERT_EQ(baked.mesh.positions.size(), made.mesh.positions.size()) << who;
     EXPECT_TRUE(baked.mesh.positions == made.mesh.positions) << who;
@@ -429,6 +432,12 @@ TEST(DefaultBodies, BakedBodyIsTheGeneratorsBody) {
     EXPECT_EQ(baked.sex, made.sex);
     for (const auto& row : measurement_table())
       EXPECT_EQ(baked.measurements.*(row.field), made.measurements.*(row.field)) << who << " " << row.key;
+    for (const auto& [key, value] : request) {
+      const auto& table = measurement_table();
+      const auto row = std::find_if(table.begin(), table.end(), [&](const MeasurementInfo& m) { return m.key == key; });
+      ASSERT_NE(row, table.end()) << key;
+      EXPECT_NEAR(baked.measurements.*(row->field), value, 0.01f) << who << " " << key;
+    }
     const auto a = baked.landmarks.named(), b = made.landmarks.named();
     for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a[i].second == b[i].second) << who << " " << a[i].first;
     ASSERT_EQ(baked.skeleton.joints.size(), made.skeleton.joints.size());
@@ -439,23 +448,27 @@ TEST(DefaultBodies, BakedBodyIsTheGeneratorsBody) {
 
 // The bake format round-trips, and damaged bytes are refused rather than read past their end.
 TEST(DefaultBodies, BakeFormatRoundTripsAndRefusesDamagedBytes) {
-  Mesh mesh;
-  mesh.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
-  mesh.normals = {Vec3f(0, 0, 1), Vec3f(0, 0, 1), Vec3f(0, 0, 1)};
-  mesh.triangles = {Tri{0, 1, 2}};
-  Mesh other = mesh;
-  other.positions[2] = Vec3f(0, 2, 0);
-  const std::string bytes = body::encode_baked_bodies({{Sex::Female, mesh}, {Sex::Male, other}});
+  body::MhShape female, male;
+  female.weight = 0.4f;
+  female.measure[2] = 0.25f;
+  male.sex = Sex::Male;
+  male.height = 0.7f;
+  male.scale = 1.02f;
+  male.measure.back() = -0.5f;
+  const std::string bytes = body::encode_baked_shapes({female, male});
   const std::span<const unsigned char> span(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
-  const Mesh male = body::decode_baked_body(span, Sex::Male);
-  EXPECT_TRUE(male.positions == other.positions);
-  EXPECT_TRUE(male.normals == other.normals);
-  EXPECT_TRUE(male.triangles == other.triangles);
-  EXPECT_TRUE(body::decode_baked_body(span, Sex::Female).positions == mesh.positions);
+  const body::MhShape m = body::decode_baked_shape(span, Sex::Male);
+  EXPECT_EQ(m.sex, Sex::Male);
+  EXPECT_EQ(m.height, 0.7f);
+  EXPECT_EQ(m.scale, 1.02f);
+  EXPECT_TRUE(m.measure == male.measure);
+  const body::MhShape f = body::decode_baked_shape(span, Sex::Female);
+  EXPECT_EQ(f.weight, 0.4f);
+  EXPECT_TRUE(f.measure == female.measure);
 
   auto refused = [](std::span<const unsigned char> b, const std::string& why) {
     try {
-      body::decode_baked_body(b, Sex::Male);
+      body::decode_baked_shape(b, Sex::Male);
     } catch (const std::runtime_error& e) {
       EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
       return;
@@ -465,11 +478,7 @@ TEST(DefaultBodies, BakeFormatRoundTripsAndRefusesDamagedBytes) {
   refused(span.first(span.size() - 5), "truncated");
   std::string bad_magic = bytes;
   bad_magic[0] = 'X';
-  refused({reinterpret_cast<const unsigned char*>(bad_magic.data()), bad_magic.size()}, "not a DRAPEBB1");
-  std::string bad_index = bytes;
-  const uint32_t past = 7;
-  std::memcpy(bad_index.data() + bad_index.size() - sizeof past, &past, sizeof past);
-  refused({reinterpret_cast<const unsigned char*>(bad_index.data()), bad_index.size()}, "past the end");
-  const std::string female_only = body::encode_baked_bodies({{Sex::Female, mesh}});
+  refused({reinterpret_cast<const unsigned char*>(bad_magic.data()), bad_magic.size()}, "not a DRAPEBB2");
+  const std::string female_only = body::encode_baked_shapes({female});
   refused({reinterpret_cast<const unsigned char*>(female_only.data()), female_only.size()}, "no body of the requested sex");
 }

@@ -22,6 +22,17 @@ inline const Body& cached_body(Sex sex) {
   return it->second;
 }
 
+// The parametric generator's average adult (the default body before MakeHuman's), for tests of
+// the explicit step's own settings, whose measured effects were found on it (~1 s to make, once).
+inline const Body& generator_body(Sex sex) {
+  static std::map<Sex, Body> bodies;
+  static std::mutex mutex;
+  std::lock_guard lock(mutex);
+  auto it = bodies.find(sex);
+  if (it == bodies.end()) it = bodies.emplace(sex, generate_default_body(sex)).first;
+  return it->second;
+}
+
 // Options for the paper's explicit step (--solver explicit), for tests of its own settings.
 inline DressOptions explicit_options() {
   DressOptions o;

@@ -50,15 +50,16 @@ PictureStats stats(const Image& image) {
   return {colours.size(), static_cast<double>(drawn) / (static_cast<double>(image.width) * image.height)};
 }
 
-// The outcomes these tests name (which sizes close, where) are the explicit solver's
-// (docs/dressing.md, "Status").
+// The outcomes these tests name (which sizes close, where) are the explicit solver's on the
+// parametric generator's average bodies, the default bodies when they were measured
+// (test::generator_body; docs/dressing.md, "Status").
 DressOptions explicit_solver() {
   DressOptions o;
   o.solver = Solver::Explicit;
   return o;
 }
 
-// Jeans on the default female body: five sizes, each dressed once (about 10-25 s on two cores), then
+// Jeans on the generator's female body: five sizes, each dressed once (about 10-25 s on two cores), then
 // every check below on them, in one test so that ctest's one process per test dresses them once.
 
 void RecommendsTheChartsSizeAndNeverOneThatDoesNotClose(const SizeAdvice* advice) {
@@ -150,7 +151,7 @@ void PressureOnTheBodyBalancesTheContactForcesOnTheCloth(const SizeAdvice* advic
 }
 
 void PicturesAreNotBlankAndDifferBetweenSizes(const SizeAdvice* advice) {
-  const Body& body = test::cached_body(Sex::Female);
+  const Body& body = test::generator_body(Sex::Female);
   const SizeTrial& m = trial(*advice, "M");
   const SizeTrial& xl = trial(*advice, "XL");
   const Image a = fit_map_picture(body, m.result, m.fit, "jeans M");
@@ -177,7 +178,7 @@ void PicturesAreNotBlankAndDifferBetweenSizes(const SizeAdvice* advice) {
 }
 
 void FitDoesNotDependOnTheThreadCount(const SizeAdvice* advice) {
-  const Body& body = test::cached_body(Sex::Female);
+  const Body& body = test::generator_body(Sex::Female);
   const SizeTrial& m = trial(*advice, "M");
   const std::vector<Garment> made{m.garment};
   const int threads = omp_get_max_threads();
@@ -191,9 +192,9 @@ void FitDoesNotDependOnTheThreadCount(const SizeAdvice* advice) {
   EXPECT_EQ(one.garments[0].strain_percent, two.garments[0].strain_percent);
 }
 
-TEST(JeansAdvice, OnTheDefaultFemaleBody) {
+TEST(JeansAdvice, OnTheGeneratorsFemaleBody) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing five sizes is too slow";
-  const SizeAdvice advice = advise_size(test::cached_body(Sex::Female), *builtin_garment("jeans"), explicit_solver());
+  const SizeAdvice advice = advise_size(test::generator_body(Sex::Female), *builtin_garment("jeans"), explicit_solver());
   {
     SCOPED_TRACE("RecommendsTheChartsSizeAndNeverOneThatDoesNotClose");
     RecommendsTheChartsSizeAndNeverOneThatDoesNotClose(&advice);

@@ -2,8 +2,6 @@
 // Shared by the dressing tests: one cache of the default bodies for the whole test program (an
 // inline function's statics are one object across translation units) and the failed-gate message.
 #include <cstdlib>
-#include <map>
-#include <mutex>
 #include <string>
 
 #include "drape/dress.hpp"
@@ -12,25 +10,26 @@ namespace drape::test {
 
 inline bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
 
-// Bodies are expensive to build: one of each per test program.
+// Bodies are expensive to build: one of each per test program, made on first use (thread-safe
+// statics, one per sex and per `make`).
+template <class Make>
+const Body& once_per_sex(Sex sex, Make make) {
+  if (sex == Sex::Male) {
+    static const Body male = make(Sex::Male);
+    return male;
+  }
+  static const Body female = make(Sex::Female);
+  return female;
+}
+
 inline const Body& cached_body(Sex sex) {
-  static std::map<Sex, Body> bodies;
-  static std::mutex mutex;
-  std::lock_guard lock(mutex);
-  auto it = bodies.find(sex);
-  if (it == bodies.end()) it = bodies.emplace(sex, default_body(sex)).first;
-  return it->second;
+  return once_per_sex(sex, [](Sex s) { return default_body(s); });
 }
 
 // The parametric generator's average adult (the default body before MakeHuman's), for tests of
 // the explicit step's own settings, whose measured effects were found on it (~1 s to make, once).
 inline const Body& generator_body(Sex sex) {
-  static std::map<Sex, Body> bodies;
-  static std::mutex mutex;
-  std::lock_guard lock(mutex);
-  auto it = bodies.find(sex);
-  if (it == bodies.end()) it = bodies.emplace(sex, generate_default_body(sex)).first;
-  return it->second;
+  return once_per_sex(sex, [](Sex s) { return generate_default_body(s); });
 }
 
 // Options for the paper's explicit step (--solver explicit), for tests of its own settings.

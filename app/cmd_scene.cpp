@@ -1,16 +1,21 @@
 // `drape scene sphere|table`: Vassilev & Spanlang fig. 7. Drops a square cloth over a sphere or a
 // table, runs until it settles and writes DIR/report.json (DESIGN.md's quality and simulation
 // keys), DIR/scene.glb and DIR/preview.png. Exit 3 when a gate failed (NaN, explosion, not settled).
+// `drape scene cusick`: the Cusick drape test of a fabric (drape/cusick.hpp), the same outputs with
+// the drape coefficient in report.json and the specimen's shadow in preview.png.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.hpp"
 #include "drape/cloth_scene.hpp"
+#include "drape/cusick.hpp"
 #include "drape/implicit.hpp"
 #include "drape/error.hpp"
 #include "drape/files.hpp"
@@ -28,8 +33,9 @@ struct SceneArgs {
   int passes = 2;
   std::string fabric = "cotton";
   float time_step = 0;
-  std::string solver = "explicit";
+  std::string solver;  // empty: explicit for sphere and table, implicit for cusick
   double max_time = 12;
+  double edge = 0.01;
   std::string out = "out";
   bool compare = true;
 };
@@ -94,10 +100,155 @@ nlohmann::json strain_json(const StrainStats& s) {
   return {{"max", s.max}, {"p99", s.p99}, {"mean_abs", s.mean_abs}, {"min", s.min}, {"global", s.global}};
 }
 
+// The specimen's shadow seen from above, as the tester's light casts it: the specimen's flat
+// outline and the support disc drawn over it. `pixels` across the specimen's diameter.
+Image shadow_picture(const CusickResult& r, double specimen_radius, int pixels) {
+  const int size = pixels + 40;
+  Image image(size, size, Vec3f::Ones());
+  const double scale = pixels / (2.0 * specimen_radius);  // pixels per metre
+  const double centre = 0.5 * size;
+  const auto put = [&](int x, int y, const Vec3f& linear) {
+    if (x < 0 || y < 0 || x >= size || y >= size) return;
+    uint8_t* p = image.pixel(x, y);
+    for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround(255.0f * linear_to_srgb(linear[k])));
+  };
+  // The shadow: every projected triangle filled (the picture's y is the scene's z).
+  const std::vector<Vec3f>& x = r.specimen.state.x;
+  const Vec3f shade = srgb8(70, 78, 96);
+  for (const Tri& t : r.specimen.model.triangles) {
+    Vec2d v[3];
+    for (int k = 0; k < 3; ++k) v[k] = Vec2d(centre + scale * x[t[k]].x(), centre + scale * x[t[k]].z());
+    const double area2 = (v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x();
+    if (std::abs(area2) < 1e-12) continue;
+    const double sign = area2 > 0 ? 1 : -1;
+    const int x0 = static_cast<int>(std::floor(std::min({v[0].x(), v[1].x(), v[2].x()})));
+    const int x1 = static_cast<int>(std::ceil(std::max({v[0].x(), v[1].x(), v[2].x()})));
+    const int y0 = static_cast<int>(std::floor(std::min({v[0].y(), v[1].y(), v[2].y()})));
+    const int y1 = static_cast<int>(std::ceil(std::max({v[0].y(), v[1].y(), v[2].y()})));
+    for (int py = y0; py <= y1; ++py)
+      for (int px = x0; px <= x1; ++px) {
+        const Vec2d p(px + 0.5, py + 0.5);
+        bool inside = true;
+        for (int k = 0; k < 3 && inside; ++k) {
+          const Vec2d& a = v[k];
+          const Vec2d& b = v[(k + 1) % 3];
+          inside = sign * ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) >= 0;
+        }
+        if (inside) put(px, py, shade);
+      }
+  }
+  // The flat specimen's outline and the support disc.
+  const auto circle = [&](double radius, const Vec3f& colour) {
+    const int steps = static_cast<int>(8 * radius * scale) + 16;
+    for (int k = 0; k < steps; ++k) {
+      const double a = 2 * std::numbers::pi * k / steps;
+      put(static_cast<int>(centre + radius * scale * std::cos(a)), static_cast<int>(centre + radius * scale * std::sin(a)), colour);
+    }
+  };
+  circle(specimen_radius, srgb8(40, 40, 40));
+  circle(r.support->radius(), srgb8(230, 160, 40));
+  return image;
+}
+
+void run_cusick_scene(const SceneArgs& a) {
+  CusickOptions o;
+  o.fabric = fabric_or_throw(a.fabric);
+  o.solver = a.solver == "explicit" ? Solver::Explicit : Solver::Implicit;
+  o.edge_length = a.edge;
+  if (!(a.max_time > 0 && a.max_time <= 600)) throw InputError("--max-time", "must be in (0, 600] s");
+  o.max_seconds = a.max_time;
+  std::fprintf(stderr, "scene cusick: %s, a %.0f cm disc on a %.0f cm support, %s solver, grid %.3g m\n",
+               o.fabric.name.c_str(), 100 * o.specimen_diameter, 100 * o.support_diameter,
+               std::string(to_string(o.solver)).c_str(), o.edge_length);
+  const CusickResult r = run_cusick(o, [](const DressProgress& p) {
+    std::fprintf(stderr, "  %s: t = %5.2f s  iterations %6llu\n", p.phase, p.simulated_seconds,
+                 static_cast<unsigned long long>(p.iterations));
+  });
+  const DressedGarment& g = r.specimen;
+  const StrainStats strain = strain_stats(g.model, g.state.x, SpringKind::Structural);
+  size_t inside = 0;
+  float deepest = 0;
+  for (const Vec3f& p : g.state.x) {
+    const float d = r.support->signed_distance(p, nullptr);
+    if (d < 0) {
+      ++inside;
+      deepest = std::max(deepest, -d);
+    }
+  }
+  const double wall = r.wall_seconds;
+  const uint64_t iterations = g.state.iterations;
+  std::fprintf(stderr, "  %s after %llu iterations (%.2f s wall): drape coefficient %.1f %%, %d nodes, max strain %.2f %%\n",
+               g.status != StepStatus::Ok ? "FAILED" : g.settled ? "settled" : "NOT settled",
+               static_cast<unsigned long long>(iterations), wall, 100 * r.drape_coefficient, r.nodes, 100 * strain.max);
+
+  nlohmann::json report;
+  report["drape_coefficient"] = r.drape_coefficient;
+  report["nodes"] = r.nodes;
+  report["areas_m2"] = {{"specimen", r.specimen_area}, {"support", r.support_area}, {"shadow", r.shadow_area}};
+  report["quality"] = {{"max_strain", strain.max},
+                       {"p99_strain", strain.p99},
+                       {"penetrating_vertices", inside},
+                       {"penetration_fraction", g.state.x.empty() ? 0.0 : static_cast<double>(inside) / static_cast<double>(g.state.x.size())},
+                       {"max_penetration_m", deepest},
+                       {"max_seam_gap_m", 0.0},
+                       {"mean_seam_gap_m", 0.0},
+                       {"settled", g.settled},
+                       {"residual", g.residual}};
+  report["simulation"] = {{"iterations", iterations},
+                          {"time_step_s", g.time_step},
+                          {"wall_seconds", wall},
+                          {"seconds_per_iteration", iterations ? wall / static_cast<double>(iterations) : 0.0},
+                          {"simulated_seconds", g.state.time},
+                          {"status", std::string(to_string(g.status))},
+                          {"vertices", g.model.particle_count()},
+                          {"springs", g.model.spring_count()}};
+  if (o.solver == Solver::Implicit)
+    report["simulation"]["newton_iterations"] = g.implicit_profile.newton_iterations;
+  report["scene"] = {{"obstacle", "cusick"},
+                     {"fabric", o.fabric.name},
+                     {"solver", std::string(to_string(o.solver))},
+                     {"specimen_diameter_m", o.specimen_diameter},
+                     {"support_diameter_m", o.support_diameter},
+                     {"edge_length_m", o.edge_length}};
+  report["gates"] = {{"finite", g.status == StepStatus::Ok}, {"settled", g.settled}};
+
+  const std::filesystem::path dir(a.out);
+  if (g.status != StepStatus::NonFinite) {
+    Scene gltf;
+    add_mesh_node(gltf, g.mesh(), "cloth");
+    add_mesh_node(gltf, r.support->mesh(), "body");
+    write_scene(dir / "scene.glb", gltf);
+    RenderOptions view;
+    view.width = 640;
+    view.height = 480;
+    view.views = {{"three-quarter", 30.0f}};
+    view.elevation_degrees = 25.0f;
+    view.floor_shadow = false;
+    view.view_labels = false;
+    Mesh cloth = g.mesh();
+    const Image side = render_views({body_item(r.support->mesh()), garment_item(cloth, 0)}, view);
+    char caption[160];
+    std::snprintf(caption, sizeof caption, "%s: drape coefficient %.1f %%, %d nodes", o.fabric.name.c_str(),
+                  100 * r.drape_coefficient, r.nodes);
+    write_png(dir / "preview.png", compose_side_by_side({side, shadow_picture(r, 0.5 * o.specimen_diameter, 440)},
+                                                        {caption, "shadow from above (circles: specimen, support)"}));
+  }
+  write_file_atomic(dir / "report.json", report.dump(2) + "\n");
+  if (g.status != StepStatus::Ok) {
+    std::fprintf(stderr, "drape: scene: simulation failed: %s\n", std::string(to_string(g.status)).c_str());
+    std::exit(kExitQualityGate);
+  }
+  if (!g.settled) {
+    std::fprintf(stderr, "drape: scene: the specimen did not settle\n");
+    std::exit(kExitQualityGate);
+  }
+}
+
 void run_scene(const SceneArgs& a) {
+  if (a.obstacle == "cusick") return run_cusick_scene(a);
   ClothSceneOptions o;
   if (a.obstacle != "sphere" && a.obstacle != "table")
-    throw InputError("scene", "unknown obstacle '" + a.obstacle + "' (sphere or table)");
+    throw InputError("scene", "unknown scene '" + a.obstacle + "' (sphere, table or cusick)");
   o.obstacle = a.obstacle == "sphere" ? SceneObstacle::Sphere : SceneObstacle::Table;
   o.n = a.n;
   o.fabric = fabric_or_throw(a.fabric);
@@ -110,7 +261,7 @@ void run_scene(const SceneArgs& a) {
   o.strain_passes = a.passes;
   if (!(a.time_step >= 0 && a.time_step < 0.1f)) throw InputError("--dt", "the time step must be in [0, 0.1) s");
   o.time_step = a.time_step;
-  o.solver = a.solver == "implicit" ? Solver::Implicit : Solver::Explicit;
+  o.solver = a.solver == "implicit" ? Solver::Implicit : Solver::Explicit;  // empty: explicit (fig. 7)
   if (!(a.max_time > 0 && a.max_time <= 600)) throw InputError("--max-time", "must be in (0, 600] s");
   const float threshold = a.threshold >= 0 ? a.threshold : o.fabric.strain_threshold;
 
@@ -206,9 +357,13 @@ void run_scene(const SceneArgs& a) {
 
 void add_scene_command(CLI::App& app) {
   auto args = std::make_shared<SceneArgs>();
-  CLI::App* cmd = app.add_subcommand("scene", "Drop a square cloth over a sphere or a table (paper fig. 7) until it settles");
-  cmd->add_option("obstacle", args->obstacle, "sphere or table")->check(CLI::IsMember({"sphere", "table"}));
-  cmd->add_option("--n", args->n, "cloth vertices per side")->capture_default_str()->check(CLI::Range(3u, 2048u));
+  CLI::App* cmd = app.add_subcommand(
+      "scene", "Drop a square cloth over a sphere or a table (paper fig. 7), or hang a fabric in the Cusick drape test, until it settles");
+  cmd->add_option("obstacle", args->obstacle,
+                  "sphere or table (fig. 7), or cusick: a 30 cm disc of the fabric clamped on an 18 cm support; "
+                  "report.json gives its drape_coefficient")
+      ->check(CLI::IsMember({"sphere", "table", "cusick"}));
+  cmd->add_option("--n", args->n, "cloth vertices per side (sphere, table)")->capture_default_str()->check(CLI::Range(3u, 2048u));
   cmd->add_option("--strain-limit", args->strain_limit, "none, position (Provot) or velocity (paper sec. 3.3)")
       ->capture_default_str()->check(CLI::IsMember({"none", "position", "velocity"}));
   cmd->add_option("--threshold", args->threshold, "stretch threshold as a fraction (default: the fabric's)")
@@ -219,9 +374,11 @@ void add_scene_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--solver", args->solver,
                   "explicit (the paper's explicit Euler with velocity modification) or implicit (implicit Euler, "
-                  "Newton on the incremental potential, 1/30 s steps)")
-      ->capture_default_str()->check(CLI::IsMember({"explicit", "implicit"}));
+                  "Newton on the incremental potential); default: explicit for sphere and table, implicit for cusick")
+      ->check(CLI::IsMember({"explicit", "implicit"}));
   cmd->add_option("--dt", args->time_step, "time step in seconds (default: the stability bound, eq. 4)");
+  cmd->add_option("--edge", args->edge, "cusick: the specimen's grid spacing in metres")->capture_default_str()
+      ->check(CLI::Range(0.0015, 0.0375));
   cmd->add_option("--max-time", args->max_time, "simulated seconds before giving up on settling")->capture_default_str();
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();
   cmd->add_flag("!--no-compare", args->compare,

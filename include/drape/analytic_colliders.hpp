@@ -1,6 +1,6 @@
 #pragma once
 // Analytic obstacles behind the drape::Collider interface: plane, sphere, box (a table top) and
-// capsule (a limb). Each may translate at a constant velocity (a moving obstacle for the sec. 5
+// capsule (a limb), cylinder (a support disc). Each may translate at a constant velocity (a moving obstacle for the sec. 5
 // force response); its distance is exact, so tests and reports can also use it as the inside test.
 #include <string>
 
@@ -76,6 +76,20 @@ class CapsuleCollider final : public AnalyticCollider {
  private:
   Vec3f a_, b_;
   float radius_;
+};
+
+// A solid upright cylinder (axis along y) with flat ends, e.g. the support disc of a drape tester.
+class CylinderCollider final : public AnalyticCollider {
+ public:
+  CylinderCollider(const Vec3f& top_centre, float radius, float height);
+  std::string_view name() const override { return "cylinder"; }
+  float signed_distance(const Vec3f& p, Vec3f* normal) const override;
+  Mesh mesh() const override;
+  float radius() const { return radius_; }
+
+ private:
+  Vec3f top_;
+  float radius_, height_;
 };
 
 }  // namespace drape

@@ -82,6 +82,17 @@ struct ClothModel {
   std::vector<float> limit_rest;
   std::vector<uint32_t> limit_colour_begin;  // colour c is [begin[c], begin[c+1])
 
+  // Bending stencils: three particles a, m, b along a line of the flat pattern, l1 = |m - a| and
+  // l2 = |b - m| apart there, with the energy k/2 |w_a x_a + w_m x_m + w_b x_b|^2 for the weights
+  // w = (1/l1, -(1/l1 + 1/l2), 1/l2): the curvature times (l1 + l2)/2, so k = B width / ((l1 + l2)/2)
+  // gives the bending energy B kappa^2 / 2 per area of a fabric of bending rigidity B. Linear in the
+  // curvature and of constant Hessian. The implicit solver bends with these and leaves out the
+  // flexion springs between the same a and b; the explicit step keeps the paper's flexion springs.
+  // Grid builders make one per flexion spring; empty for triangle meshes.
+  std::vector<std::array<uint32_t, 3>> bend_stencil;
+  std::vector<std::array<float, 3>> bend_weight;
+  std::vector<float> bend_stiffness;  // N m (the weights are in 1/m)
+
   // Grid builders fill these (0 for meshes): particle index of grid vertex (ix, iy) is iy * nx + ix.
   uint32_t grid_nx = 0, grid_ny = 0;
 
@@ -124,6 +135,11 @@ struct ClothSpec {
     SpringKind kind;
   };
   std::vector<Spring> springs;
+  struct Bend {
+    uint32_t a, m, b;
+    float stiffness;  // N m, see ClothModel::bend_stencil
+  };
+  std::vector<Bend> bends;  // weights from the flat positions
   // Kinds whose springs velocity / position modification limit (bit i = SpringKind i).
   uint32_t limited_kinds = 1u << static_cast<unsigned>(SpringKind::Structural);
   uint32_t grid_nx = 0, grid_ny = 0;

@@ -21,6 +21,9 @@ struct Fabric {
   float stretch_weft = 50.0f;     // N/m, along the weft (the flat pattern's u / x axis)
   float shear = 15.0f;            // N/m, shear springs (quad diagonals)
   float bend = 2.0f;              // N/m, flexion springs ([i,j]-[i+2,j]) and bending springs across edges
+  // N m: bending rigidity, the moment per unit width per unit curvature (KES B), which the implicit
+  // solver's bending stencils use in place of the flexion springs (ClothModel::bend_stencil).
+  float bending_rigidity = 1e-5f;
   float damping_ratio = 0.1f;     // spring damping as a fraction of critical damping of one spring
   float air_damping = 0.5f;       // 1/s: viscous damping f = -gamma m v (paper sec. 2.2, C_vd = gamma m)
   float air_drag = 0.6f;          // kg/m^3: quadratic drag f = -air_drag * area * |v| v (rho_air C_d / 2)

@@ -8,7 +8,9 @@
 // SpringKind::Seam between the sewn vertex pairs; they are also velocity-limited (sec. 3.3 with a
 // rest length of 0), so a seam, once pulled closer, never opens again.
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <unordered_map>
 
 #include "dress/stages.hpp"
 
@@ -42,6 +44,20 @@ void append_grid_panel(ClothSpec& spec, const PanelMesh& panel, std::span<const 
   }
   for (const auto& [a, b] : g.shear) add(a, b, f.shear, SpringKind::Shear);
   for (const auto& [a, b] : g.flexion) add(a, b, 0.5f * f.bend, SpringKind::Flexion);
+  // A bending stencil through each flexion spring's middle vertex, the lattice point between its
+  // ends: k = B h / h for the lattice's spacing h across and along the line.
+  std::unordered_map<int64_t, uint32_t> at_lattice;
+  const auto key = [](int32_t i, int32_t j) { return (static_cast<int64_t>(i) << 32) ^ static_cast<int64_t>(static_cast<uint32_t>(j)); };
+  for (size_t v = 0; v < g.lattice.size(); ++v)
+    if (g.lattice[v][0] != INT32_MIN) at_lattice.emplace(key(g.lattice[v][0], g.lattice[v][1]), static_cast<uint32_t>(v));
+  for (const auto& [a, b] : g.flexion) {
+    const auto& la = g.lattice[a];
+    const auto& lb = g.lattice[b];
+    if (la[0] == INT32_MIN || lb[0] == INT32_MIN) continue;
+    const auto middle = at_lattice.find(key((la[0] + lb[0]) / 2, (la[1] + lb[1]) / 2));
+    if (middle == at_lattice.end()) continue;
+    spec.bends.push_back({base + a, base + middle->second, base + b, f.bending_rigidity});
+  }
   (void)placed;
 }
 

@@ -191,4 +191,70 @@ Mesh CapsuleCollider::mesh() const {
   return m;
 }
 
+CylinderCollider::CylinderCollider(const Vec3f& top_centre, float radius, float height)
+    : top_(top_centre), radius_(radius), height_(height) {
+  if (!(radius > 0) || !(height > 0)) throw std::invalid_argument("CylinderCollider: radius and height must be > 0");
+}
+
+// In the (radial, axial) half-plane the cylinder is a rectangle: the box's distance in 2D.
+float CylinderCollider::signed_distance(const Vec3f& p, Vec3f* normal) const {
+  const Vec3f local = p - top_ - offset_;
+  const Vec2f radial(local.x(), local.z());
+  const float r = radial.norm();
+  const Vec2f out_dir = r > 0 ? Vec2f(radial / r) : Vec2f(1.0f, 0.0f);
+  const float half = 0.5f * height_;
+  const float axial = local.y() + half;  // from the middle of the cylinder
+  const Vec2f q(r - radius_, std::abs(axial) - half);
+  const float up = axial >= 0 ? 1.0f : -1.0f;
+  const Vec2f outside = q.cwiseMax(0.0f);
+  const float out_len = outside.norm();
+  if (out_len > 0) {
+    if (normal) {
+      const Vec2f n = outside / out_len;
+      *normal = Vec3f(n.x() * out_dir.x(), n.y() * up, n.x() * out_dir.y());
+    }
+    return out_len;
+  }
+  const bool side = q.x() > q.y();
+  if (normal) *normal = side ? Vec3f(out_dir.x(), 0.0f, out_dir.y()) : Vec3f(0.0f, up, 0.0f);
+  return side ? q.x() : q.y();
+}
+
+Mesh CylinderCollider::mesh() const {
+  Mesh m;
+  m.name = "cylinder";
+  const Vec3f top = top_ + offset_, bottom = top - Vec3f(0.0f, height_, 0.0f);
+  const int segments = 96;
+  const auto ring = [&](const Vec3f& centre, bool side, float ny) {
+    for (int s = 0; s <= segments; ++s) {
+      const float phi = 2 * std::numbers::pi_v<float> * static_cast<float>(s) / segments;
+      const Vec3f radial(std::cos(phi), 0.0f, -std::sin(phi));
+      m.positions.push_back(centre + radius_ * radial);
+      m.normals.push_back(side ? radial : Vec3f(0.0f, ny, 0.0f));
+    }
+  };
+  const uint32_t row = segments + 1;
+  // The side: two rings with radial normals; counter-clockwise seen from outside.
+  ring(bottom, true, 0.0f);
+  ring(top, true, 0.0f);
+  for (uint32_t s = 0; s < static_cast<uint32_t>(segments); ++s) {
+    m.triangles.push_back({s, s + 1, s + row});
+    m.triangles.push_back({s + 1, s + row + 1, s + row});
+  }
+  // The ends: a fan each, facing up and down.
+  for (int end = 0; end < 2; ++end) {
+    const bool upper = end == 0;
+    const Vec3f centre = upper ? top : bottom;
+    const uint32_t hub = static_cast<uint32_t>(m.positions.size());
+    m.positions.push_back(centre);
+    m.normals.push_back(Vec3f(0.0f, upper ? 1.0f : -1.0f, 0.0f));
+    ring(centre, false, upper ? 1.0f : -1.0f);
+    for (uint32_t s = 0; s < static_cast<uint32_t>(segments); ++s) {
+      if (upper) m.triangles.push_back({hub, hub + 1 + s, hub + 2 + s});
+      else m.triangles.push_back({hub, hub + 2 + s, hub + 1 + s});
+    }
+  }
+  return m;
+}
+
 }  // namespace drape

@@ -168,6 +168,18 @@ ClothModel compile(ClothSpec spec) {
     m.flat_position = std::move(spec.flat_positions);
   }
 
+  // Bending stencils, their weights from the flat pattern.
+  for (const ClothSpec::Bend& bd : spec.bends) {
+    if (bd.a >= n || bd.m >= n || bd.b >= n || bd.a == bd.m || bd.m == bd.b || bd.a == bd.b)
+      throw std::invalid_argument("compile: bending stencil with bad particle index");
+    const float l1 = (m.flat_position[bd.m] - m.flat_position[bd.a]).norm();
+    const float l2 = (m.flat_position[bd.b] - m.flat_position[bd.m]).norm();
+    if (!(l1 > 0) || !(l2 > 0) || !(bd.stiffness >= 0)) throw std::invalid_argument("compile: bad bending stencil constants");
+    m.bend_stencil.push_back({bd.a, bd.m, bd.b});
+    m.bend_weight.push_back({1.0f / l1, -(1.0f / l1 + 1.0f / l2), 1.0f / l2});
+    m.bend_stiffness.push_back(bd.stiffness);
+  }
+
   // Springs sorted by kind (stable: within a kind the builder's order is kept).
   std::stable_sort(spec.springs.begin(), spec.springs.end(),
                    [](const ClothSpec::Spring& a, const ClothSpec::Spring& b) { return a.kind < b.kind; });
@@ -302,6 +314,11 @@ ClothSpec grid_cloth_spec(const Fabric& fabric, const GridClothOptions& o) {
       }
       if (ix + 2 < nx) add(i, i + 2, 2 * hu, fabric.bend * hv / (2 * hu), SpringKind::Flexion);
       if (iy + 2 < ny) add(i, i + 2 * nx, 2 * hv, fabric.bend * hu / (2 * hv), SpringKind::Flexion);
+      // Bending stencils along the same lines: k = B width / spacing, a line on the cloth's edge
+      // standing for half a row's width.
+      const float row = (iy == 0 || iy + 1 == ny) ? 0.5f * hv : hv, column = (ix == 0 || ix + 1 == nx) ? 0.5f * hu : hu;
+      if (ix + 2 < nx) spec.bends.push_back({i, i + 1, i + 2, fabric.bending_rigidity * row / hu});
+      if (iy + 2 < ny) spec.bends.push_back({i, i + nx, i + 2 * nx, fabric.bending_rigidity * column / hv});
     }
   return spec;
 }

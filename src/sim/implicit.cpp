@@ -16,11 +16,14 @@
 #include <Eigen/Sparse>
 #pragma GCC diagnostic pop
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 
 #include "sim/parallel.hpp"
 
@@ -154,8 +157,18 @@ struct ImplicitSolver::Impl {
   // values[block_offset[3 b + k]] (its three rows follow). Blocks 0..n-1 are the diagonal.
   SparseMatrix matrix;
   std::vector<int> block_offset;
-  // Off-diagonal blocks and the springs that share each (CSR, in spring order).
+  // Off-diagonal blocks and the springs that share each (CSR, in spring order), and each block's
+  // two particles.
   std::vector<uint32_t> offdiag_begin, offdiag_spring, offdiag_block, offdiag_block_t;
+  std::vector<std::array<uint32_t, 2>> offdiag_pair;
+  // Bending stencils (ClothModel::bend_stencil): their Hessian is constant, summed once per particle
+  // (bend_diag) and per off-diagonal block (bend_offdiag); flexion springs a stencil stands in for
+  // are left out (spring_skipped).
+  std::vector<double> bend_diag, bend_offdiag;
+  std::vector<uint8_t> spring_skipped;
+  std::vector<Vec3d> bend_gradient;  // per particle, at the iterate
+  // sum k/2 |d|^2 over the stencils at `at`, and (with `gradient`) each particle's gradient.
+  double bend_terms(const std::vector<Vec3d>& at, bool gradient);
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky;
 
   // Per step and iteration (allocated once).
@@ -224,6 +237,25 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
   friction_force.assign(n, 0.0);
   surface_velocity.assign(n, Vec3d::Zero());
   spring_term.resize(m.spring_count());
+  bend_diag.assign(n, 0.0);
+  bend_gradient.assign(n, Vec3d::Zero());
+  spring_skipped.assign(m.spring_count(), 0);
+  if (!m.bend_stencil.empty()) {
+    // The flexion springs between the ends of a stencil.
+    std::vector<std::array<uint32_t, 2>> ends;
+    for (const auto& st : m.bend_stencil) ends.push_back({std::min(st[0], st[2]), std::max(st[0], st[2])});
+    std::sort(ends.begin(), ends.end());
+    const SpringRange flex = m.range(SpringKind::Flexion);
+    for (uint32_t k = flex.begin; k < flex.end; ++k) {
+      const std::array<uint32_t, 2> e{std::min(m.spring_a[k], m.spring_b[k]), std::max(m.spring_a[k], m.spring_b[k])};
+      spring_skipped[k] = std::binary_search(ends.begin(), ends.end(), e) ? 1 : 0;
+    }
+    for (size_t q = 0; q < m.bend_stencil.size(); ++q)
+      for (int j = 0; j < 3; ++j) {
+        const double w = m.bend_weight[q][static_cast<size_t>(j)];
+        bend_diag[m.bend_stencil[q][static_cast<size_t>(j)]] += static_cast<double>(m.bend_stiffness[q]) * w * w;
+      }
+  }
   for (Eigen::VectorXd* v : {&gradient, &direction, &residual_vec, &search, &product, &preconditioned})
     v->setZero(static_cast<Eigen::Index>(3 * n));
   block_sum.assign(std::max(sim::block_count(n), sim::block_count(m.spring_count())), 0.0);
@@ -233,11 +265,17 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
 void ImplicitSolver::Impl::analyse_pattern() {
   const size_t springs = model.spring_count();
   // Off-diagonal blocks: one per distinct (a, b) pair with a < b, in first-spring order.
+  // Pairs of a bending stencil that no spring joins get a block too (kNoSpring).
+  constexpr uint32_t kNoSpring = UINT32_MAX;
   std::vector<std::array<uint32_t, 3>> keyed(springs);  // min, max, spring
   for (size_t s = 0; s < springs; ++s) {
     const uint32_t a = model.spring_a[s], b = model.spring_b[s];
     keyed[s] = {std::min(a, b), std::max(a, b), static_cast<uint32_t>(s)};
   }
+  for (const auto& st : model.bend_stencil)
+    for (const auto& [j, l] : {std::pair{0, 1}, std::pair{1, 2}, std::pair{0, 2}})
+      keyed.push_back({std::min(st[static_cast<size_t>(j)], st[static_cast<size_t>(l)]),
+                       std::max(st[static_cast<size_t>(j)], st[static_cast<size_t>(l)]), kNoSpring});
   std::sort(keyed.begin(), keyed.end());
   std::vector<std::array<uint32_t, 2>> blocks;  // (row particle, column particle): diagonal first
   blocks.reserve(n + 2 * springs);
@@ -246,6 +284,7 @@ void ImplicitSolver::Impl::analyse_pattern() {
   offdiag_spring.clear();
   offdiag_block.clear();
   offdiag_block_t.clear();
+  offdiag_pair.clear();
   for (size_t k = 0; k < keyed.size(); ++k) {
     const auto [lo, hi, s] = keyed[k];
     if (lo == hi) continue;  // a spring from a particle to itself has no force
@@ -255,10 +294,21 @@ void ImplicitSolver::Impl::analyse_pattern() {
       blocks.push_back({lo, hi});
       offdiag_block_t.push_back(static_cast<uint32_t>(blocks.size()));
       blocks.push_back({hi, lo});
+      offdiag_pair.push_back({lo, hi});
     }
-    offdiag_spring.push_back(s);
+    if (s != kNoSpring) offdiag_spring.push_back(s);
   }
   offdiag_begin.push_back(static_cast<uint32_t>(offdiag_spring.size()));
+  // The stencils' constant off-diagonal terms, per block.
+  bend_offdiag.assign(offdiag_pair.size(), 0.0);
+  for (size_t q = 0; q < model.bend_stencil.size(); ++q)
+    for (const auto& [j, l] : {std::pair{0, 1}, std::pair{1, 2}, std::pair{0, 2}}) {
+      const uint32_t a = model.bend_stencil[q][static_cast<size_t>(j)], b = model.bend_stencil[q][static_cast<size_t>(l)];
+      const std::array<uint32_t, 2> pair{std::min(a, b), std::max(a, b)};
+      const size_t block = static_cast<size_t>(std::lower_bound(offdiag_pair.begin(), offdiag_pair.end(), pair) - offdiag_pair.begin());
+      bend_offdiag[block] += static_cast<double>(model.bend_stiffness[q]) * model.bend_weight[q][static_cast<size_t>(j)] *
+                             model.bend_weight[q][static_cast<size_t>(l)];
+    }
 
   std::vector<Eigen::Triplet<double, int>> triplets;
   triplets.reserve(9 * blocks.size());
@@ -366,6 +416,23 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
     block_sum[b] = e;
   });
   for (size_t b = 0; b < sim::block_count(springs); ++b) total += block_sum[b];
+  return total + bend_terms(at, false);
+}
+
+double ImplicitSolver::Impl::bend_terms(const std::vector<Vec3d>& at, bool with_gradient) {
+  const ClothModel& m = model;
+  if (with_gradient) std::fill(bend_gradient.begin(), bend_gradient.end(), Vec3d::Zero());
+  double total = 0;
+  for (size_t q = 0; q < m.bend_stencil.size(); ++q) {
+    const auto& st = m.bend_stencil[q];
+    const auto& w = m.bend_weight[q];
+    const double k = m.bend_stiffness[q];
+    const Vec3d d = static_cast<double>(w[0]) * at[st[0]] + static_cast<double>(w[1]) * at[st[1]] +
+                    static_cast<double>(w[2]) * at[st[2]];
+    total += 0.5 * k * d.squaredNorm();
+    if (with_gradient)
+      for (size_t j = 0; j < 3; ++j) bend_gradient[st[j]] += (k * static_cast<double>(w[j])) * d;
+  }
   return total;
 }
 
@@ -377,6 +444,7 @@ void ImplicitSolver::Impl::spring_terms(const std::vector<Vec3d>& at, const Impl
     for (size_t k = begin; k < end; ++k) {
       SpringTerm& t = spring_term[k];
       t = SpringTerm{};
+      if (spring_skipped[k]) continue;
       const Vec3d d = at[m.spring_b[k]] - at[m.spring_a[k]];
       const double l = d.norm();
       if (k >= seams.begin && k < seams.end) {
@@ -403,6 +471,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
     }
   };
   spring_terms(x, s);
+  bend_terms(x, true);
   // Per particle: diagonal block and gradient (springs in the model's incidence order).
   const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
   sim::parallel_blocks(n, [&](size_t b, size_t begin, size_t end) {
@@ -412,8 +481,8 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
       Mat3d diag = Mat3d::Zero();
       if (free[i]) {
         const double mi = m.inertial_mass(i) * inv_h2;
-        grad += mi * (x[i] - y[i]) - static_cast<double>(m.mass[i]) * g;
-        diag.diagonal().array() += mi;
+        grad += mi * (x[i] - y[i]) - static_cast<double>(m.mass[i]) * g + bend_gradient[i];
+        diag.diagonal().array() += mi + bend_diag[i];
         for (uint32_t q = m.incident_begin[i]; q < m.incident_begin[i + 1]; ++q) {
           const SpringTerm& t = spring_term[m.incident_spring[q]];
           grad -= static_cast<double>(m.incident_sign[q]) * t.gradient_b;  // sign +1: i is the a end
@@ -454,13 +523,9 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
   sim::parallel_blocks(offdiag_block.size(), [&](size_t, size_t begin, size_t end) {
     for (size_t q = begin; q < end; ++q) {
       Mat3d sum = Mat3d::Zero();
-      uint32_t a = 0, b = 0;
-      for (uint32_t j = offdiag_begin[q]; j < offdiag_begin[q + 1]; ++j) {
-        const uint32_t k = offdiag_spring[j];
-        sum -= spring_term[k].hessian;
-        a = m.spring_a[k];
-        b = m.spring_b[k];
-      }
+      for (uint32_t j = offdiag_begin[q]; j < offdiag_begin[q + 1]; ++j) sum -= spring_term[offdiag_spring[j]].hessian;
+      sum.diagonal().array() += bend_offdiag[q];
+      const auto [a, b] = offdiag_pair[q];
       if (!free[a] || !free[b]) sum.setZero();
       set_block(offdiag_block[q], sum);
       set_block(offdiag_block_t[q], sum.transpose());
@@ -499,11 +564,12 @@ float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
   const double gscale = s.gravity.norm() > 0 ? static_cast<double>(s.gravity.norm()) : 9.81;
   const double mu = std::max(0.0f, s.friction);
   spring_terms(x, s);
+  bend_terms(x, true);
   const Vec3d gravity = s.gravity.cast<double>();
   float worst = 0;
   for (size_t i = 0; i < n; ++i) {
     if (!free[i]) continue;
-    Vec3d force = static_cast<double>(m.mass[i]) * gravity;
+    Vec3d force = static_cast<double>(m.mass[i]) * gravity - bend_gradient[i];
     for (uint32_t q = m.incident_begin[i]; q < m.incident_begin[i + 1]; ++q)
       force += static_cast<double>(m.incident_sign[q]) * spring_term[m.incident_spring[q]].gradient_b;
     if (in_range[i]) {
@@ -590,7 +656,9 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     // The Newton direction: conjugate gradients preconditioned by the last factorisation (the
     // matrix changes little from one iteration to the next), or a fresh factorisation when there is
     // none yet in this step or they do not reach the tolerance in kMaxPcgIterations.
-    if (!w.factored || !w.preconditioned_solve()) {
+    const bool solved = w.factored && w.preconditioned_solve();
+    timer.mark(profile ? profile->solve : scratch_time);
+    if (!solved) {
       {
         const std::lock_guard<std::mutex> hold(blas_lock());
         w.cholesky.factorize(w.matrix);

@@ -39,6 +39,70 @@ ClothModel cloth_over_sphere(uint32_t n) {
   return grid_cloth(fabric_or_throw("cotton"), o);
 }
 
+// A horizontal strip of `cells` x 4 cells of side h at y = 1, clamped along one end: its first two
+// columns (x = -h and 0) are pinned, so the slope there is zero; the rest is free.
+struct Strip {
+  ClothModel model;
+  ClothState state;
+  uint32_t nx = 0, ny = 5;
+};
+Strip clamped_strip(const Fabric& fabric, uint32_t cells, float h) {
+  GridClothOptions o;
+  o.nx = cells + 2;
+  o.ny = 5;
+  o.width = h * static_cast<float>(o.nx - 1);
+  o.height = h * static_cast<float>(o.ny - 1);
+  o.origin = Vec3f(-h, 1.0f, 0.0f);
+  ClothSpec spec = grid_cloth_spec(fabric, o);
+  spec.pinned.assign(spec.positions.size(), 0);
+  for (uint32_t iy = 0; iy < o.ny; ++iy) spec.pinned[iy * o.nx] = spec.pinned[iy * o.nx + 1] = 1;
+  Strip strip{compile(std::move(spec)), {}, o.nx, o.ny};
+  strip.state = initial_state(strip.model);
+  return strip;
+}
+
+// Quasi-static steps until the largest net force is at most `residual` of a particle's weight.
+float hang(Strip& strip, float residual) {
+  ImplicitSolver solver(strip.model);
+  ImplicitSettings settings = default_implicit_settings(strip.model);
+  settings.quasi_static = true;
+  settings.time_step = 0.05;
+  ImplicitStepStats stats;
+  for (int steps = 0; steps < 100; ++steps) {
+    EXPECT_EQ(solver.step(strip.state, {}, settings, &stats), StepStatus::Ok);
+    if (stats.converged && stats.residual <= residual) break;
+  }
+  return stats.residual;
+}
+
+// The strip bending under its own weight (bending stencils, ClothModel::bend_stencil). Small
+// deflections: Euler-Bernoulli's cantilever under a uniform load q per area, tip deflection
+// q L^4 / (8 B) for the bending rigidity B.
+TEST(ImplicitSolver, CantileverStripBendsAsEulerBernoulliPredicts) {
+  const Fabric fabric = fabric_or_throw("cotton");
+  const float length = 0.03f, h = 0.0015f;
+  Strip strip = clamped_strip(fabric, static_cast<uint32_t>(std::lround(length / h)), h);
+  ASSERT_FALSE(strip.model.bend_stencil.empty());
+  ASSERT_LE(hang(strip, 0.001f), 0.001f);
+  double tip = 0;
+  for (uint32_t iy = 0; iy < strip.ny; ++iy) tip += 1.0 - strip.state.x[iy * strip.nx + strip.nx - 1].y();
+  tip /= strip.ny;
+  const double q = 9.81 * fabric.areal_density, expected = q * std::pow(length, 4) / (8.0 * fabric.bending_rigidity);
+  ASSERT_LT(expected, 0.1 * length) << "the strip must stay in the small-deflection range";
+  EXPECT_NEAR(tip, expected, 0.15 * expected);
+}
+
+// The flexion springs the stencils stand in for do not bend the cloth a second time: a strip with
+// no bending rigidity does not hold itself up (the paper's flexion springs alone would hold a few
+// millimetres of it at most).
+TEST(ImplicitSolver, WithoutBendingRigidityTheStripHangsDown) {
+  Fabric fabric = fabric_or_throw("cotton");
+  fabric.bending_rigidity = 0;
+  Strip strip = clamped_strip(fabric, 20, 0.0015f);
+  hang(strip, 0.01f);
+  EXPECT_LT(strip.state.x[strip.nx - 1].y(), 1.0f - 0.02f);
+}
+
 TEST(ImplicitSolver, HangingClothReachesEquilibriumQuasiStatically) {
   const ClothModel m = hanging_cloth(16, true);
   ClothState s = initial_state(m);

@@ -47,7 +47,7 @@ fuzz: deps
 	cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_FUZZ=ON \
 	  -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14
 	cmake --build build-fuzz -j $(JOBS)
-	@echo "fuzz targets: build-fuzz/fuzz_{obj,ply,gltf,garment_json,garmentcode,dxf}  (run e.g. fuzz/run.sh obj 1000000 600 tests/corpus/info)"
+	@echo "fuzz targets: build-fuzz/fuzz_{obj,ply,gltf,garment_json,garmentcode,dxf,bvh,web}  (run e.g. fuzz/run.sh obj 1000000 600 tests/corpus/info)"
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')

@@ -14,9 +14,9 @@ binary=build-fuzz/fuzz_$target
 kept=tests/corpus/fuzz/$target
 work=${DRAPE_FUZZ_WORK:-/tmp/drape-fuzz}/$target
 mkdir -p "$kept" "$work/corpus"
-# Garment files are larger than meshes; 64 KiB keeps whole patterns.
+# Garment and motion files are larger than meshes; 64 KiB keeps whole patterns and short motions.
 case $target in
-  garment_json | garmentcode | dxf) max_len=65536 ;;
+  garment_json | garmentcode | dxf | bvh) max_len=65536 ;;
   *) max_len=16384 ;;
 esac
 options="-timeout=10 -rss_limit_mb=2048 -max_len=$max_len -artifact_prefix=$work/"

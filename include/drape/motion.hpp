@@ -60,8 +60,9 @@ struct Motion {
 // BVH text (any line endings, tabs or spaces, any Euler order per joint, position channels on any
 // joint). Refuses, with InputError(source, "line N: ..."), what is malformed: unknown keywords,
 // unbalanced braces, channel counts that are not 3 or 6 (or 0 on end sites), unknown channel names,
-// missing or non-finite numbers, a frame count that does not match the values, more than 4096 joints
-// or frames of motion with no joints. `source` names the input in messages.
+// missing or non-finite numbers, offsets and channel values beyond ±1e9, a frame count that does not
+// match the values, more than 4096 joints or frames of motion with no joints. `source` names the
+// input in messages.
 Motion parse_bvh(std::string_view text, const std::string& source, const MotionOptions& options = {});
 
 // A motion from the first animation of a glTF scene: the joints of its first skin (or, without a

@@ -24,6 +24,9 @@ namespace {
 
 constexpr size_t kMaxJoints = 4096;
 constexpr size_t kMaxDepth = 512;
+// No length or angle of a motion comes near it; beyond it a value would not stay finite as a float
+// (a rotation's radians, an offset plus a position channel, a chain of 512 joints' offsets).
+constexpr double kMaxMagnitude = 1e9;
 
 struct Token {
   std::string_view text;
@@ -76,6 +79,13 @@ class Tokens {
       fail(t.line, fmt::format("{} '{}' is not a number", what, motion_detail::printable(t.text)));
     if (!std::isfinite(value)) fail(t.line, fmt::format("{} '{}' is not finite", what, motion_detail::printable(t.text)));
     return value;
+  }
+  // A length or an angle: a number within ±kMaxMagnitude.
+  double value(std::string_view what) {
+    const size_t line = peek().line;
+    const double v = number(what);
+    if (std::abs(v) > kMaxMagnitude) fail(line, fmt::format("{} {:g} is out of range (at most {:g} either way)", what, v, kMaxMagnitude));
+    return v;
   }
 
  private:
@@ -146,7 +156,7 @@ Motion parse_bvh(std::string_view text, const std::string& source, const MotionO
       j.line = t.line;
       tokens.expect("{");
       tokens.expect("OFFSET");
-      for (int k = 0; k < 3; ++k) j.offset[k] = static_cast<float>(tokens.number(fmt::format("joint '{}' OFFSET", motion_detail::printable(j.name))));
+      for (int k = 0; k < 3; ++k) j.offset[k] = static_cast<float>(tokens.value(fmt::format("joint '{}' OFFSET", motion_detail::printable(j.name))));
       const Token ch = tokens.next();
       if (ch.text != "CHANNELS")
         tokens.fail(ch.line, fmt::format("joint '{}': expected CHANNELS after its OFFSET, found '{}'", motion_detail::printable(j.name),
@@ -170,7 +180,7 @@ Motion parse_bvh(std::string_view text, const std::string& source, const MotionO
       if (stack.empty() || stack.back() == -2) tokens.fail(t.line, "an End Site outside a joint");
       tokens.expect("{");
       tokens.expect("OFFSET");
-      for (int k = 0; k < 3; ++k) tokens.number("End Site OFFSET");
+      for (int k = 0; k < 3; ++k) tokens.value("End Site OFFSET");
       stack.push_back(-2);
     } else if (t.text == "}") {
       if (stack.empty()) tokens.fail(t.line, "a '}' with no joint open");
@@ -220,7 +230,7 @@ Motion parse_bvh(std::string_view text, const std::string& source, const MotionO
     for (size_t c = 0; c < channel_count; ++c) {
       if (tokens.at_end())
         tokens.fail(tokens.line(), fmt::format("frame {} ends after {} of its {} values ({} frames declared)", f, c, channel_count, m.frame_count));
-      row[c] = tokens.number(fmt::format("frame {} value {}", f, c + 1));
+      row[c] = tokens.value(fmt::format("frame {} value {}", f, c + 1));
     }
     for (size_t j = 0; j < nj; ++j) {
       const BvhJoint& joint = joints[j];

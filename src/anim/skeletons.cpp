@@ -169,6 +169,9 @@ JointMap parse_joint_map(std::string_view json, const std::string& source, std::
     j = nlohmann::json::parse(json);
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(source, fmt::format("not JSON (byte {})", e.byte));
+  } catch (const nlohmann::json::out_of_range&) {
+    // A number too large for a double ("1e999"); nlohmann does not say where it is.
+    throw InputError(source, "not JSON (a number too large for a double)");
   }
   if (!j.is_object()) throw InputError(source, "a joint map is a JSON object {\"Hips\": \"joint name\", ...}");
   JointMap map{"file", std::vector<int>(kCanonical.size(), -1)};

@@ -51,27 +51,10 @@ void refuse_external_files(const std::string& bytes, const std::string& source) 
 
 }  // namespace
 
-Body body_from_measurements(const nlohmann::json& request) {
-  if (!request.is_object())
-    throw RequestError(400, "expected a JSON object with \"sex\" and \"measurements\"");
-  Sex sex = Sex::Female;
-  if (const auto it = request.find("sex"); it != request.end()) {
-    if (!it->is_string() || (*it != "female" && *it != "male"))
-      throw RequestError(400, "sex: expected \"female\" or \"male\"");
-    sex = *it == "male" ? Sex::Male : Sex::Female;
-  }
-  const auto m = request.find("measurements");
-  if (m == request.end() || (m->is_object() && m->empty())) return default_body(sex);
-  if (!m->is_object())
-    throw RequestError(400, "measurements: expected an object of metres, e.g. {\"height\": 1.68}");
-  std::string text;
-  for (const auto& [key, value] : m->items()) {
-    if (!value.is_number())
-      throw RequestError(400, fmt::format("measurements: '{}' is not a number of metres", key));
-    text += fmt::format("{}{}={}", text.empty() ? "" : ",", key, value.get<double>());
-  }
+Body body_from_measurements(const BodyRequest& request) {
+  if (request.measurements.empty()) return default_body(request.sex);
   try {
-    return make_human_body(sex, parse_measurements(text));
+    return make_human_body(request.sex, request.measurements);
   } catch (const InputError& e) {
     rethrow_as(e, "measurements");
   }

@@ -10,9 +10,14 @@
 
 namespace drape::web {
 
-// {"sex": "female"|"male" (default female), "measurements": {"height": 1.68, ...}} (metres, keys
-// of measurement_table(); "chest" = bust). No measurements: the built-in body of that sex.
-Body body_from_measurements(const nlohmann::json& request);
+// A body asked for by measurements (parse_body_request in web/requests.hpp reads it from JSON).
+struct BodyRequest {
+  Sex sex = Sex::Female;
+  MeasurementRequest measurements;  // metres, keys of measurement_table(); none: the built-in body
+};
+// The body of that sex made to those measurements; RequestError 400 for a combination no human
+// body has.
+Body body_from_measurements(const BodyRequest& request);
 
 struct Upload {
   std::string filename;  // the shopper's name for it: only its extension is used

@@ -16,6 +16,7 @@
 #include "web/http.hpp"
 #include "web/ids.hpp"
 #include "web/request_error.hpp"
+#include "web/requests.hpp"
 #include "web/service.hpp"
 
 namespace drape {
@@ -29,7 +30,8 @@ void send_json(httplib::Response& res, int status, const json& body) {
 }
 
 void send_error(httplib::Response& res, int status, const std::string& message) {
-  send_json(res, status, json{{"error", message}});
+  res.status = status;
+  res.set_content(web::error_answer(message), "application/json");
 }
 
 // A finished file of a body or try-on, read whole (a few MB at most) so that a DELETE meanwhile
@@ -260,40 +262,17 @@ void WebServer::Impl::routes() {
 }
 
 void WebServer::Impl::post_body(const httplib::Request& req, httplib::Response& res) {
-  Body body;
-  if (req.is_multipart_form_data()) {
-    if (!req.has_file("file")) return send_error(res, 400, "file: no file in the upload (field 'file')");
-    web::Upload upload;
-    const httplib::MultipartFormData file = req.get_file_value("file");
-    upload.filename = file.filename;
-    upload.bytes = file.content;
-    if (req.has_file("units")) upload.units = req.get_file_value("units").content;
-    if (req.has_file("up")) upload.up = req.get_file_value("up").content;
-    body = web::body_from_upload(upload, options.max_upload_triangles);
-  } else {
-    const json request = json::parse(req.body, nullptr, false);
-    if (request.is_discarded())
-      return send_error(
-          res, 400,
-          "expected JSON {\"sex\": ..., \"measurements\": {...}} or a multipart upload of a body file");
-    body = web::body_from_measurements(request);
-  }
+  Body body = req.is_multipart_form_data()
+                  ? web::body_from_upload(web::upload_from_form(req), options.max_upload_triangles)
+                  : web::body_from_measurements(web::parse_body_request(req.body));
   send_json(res, 201, body_json(service.add_body(std::move(body))));
   res.set_header("Cache-Control", "private, no-store");
 }
 
 void WebServer::Impl::post_tryon(const httplib::Request& req, httplib::Response& res) {
-  const json request = json::parse(req.body, nullptr, false);
-  if (request.is_discarded() || !request.is_object())
-    return send_error(res, 400,
-                      "expected JSON {\"body\": ID, \"garment\": NAME, \"size\": SIZE or \"auto\"}");
-  for (const char* key : {"body", "garment", "size"})
-    if (!request.contains(key) || !request[key].is_string())
-      return send_error(res, 400, fmt::format("{}: missing (a string)", key));
-  const std::string body = request["body"];
-  if (!web::is_id(body)) return send_error(res, 404, "no such body (it may have expired or been deleted)");
+  const web::TryOnRequest request = web::parse_tryon_request(req.body);
   try {
-    const auto submitted = service.submit(body, request["garment"], request["size"]);
+    const auto submitted = service.submit(request.body, request.garment, request.size);
     send_json(res, submitted.cached ? 200 : 202, json{{"id", submitted.id}, {"cached", submitted.cached}});
   } catch (const web::RequestError& e) {
     send_error(res, e.status(), e.what());

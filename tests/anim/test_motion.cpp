@@ -129,6 +129,9 @@ INSTANTIATE_TEST_SUITE_P(
         Malformed{"bad_offset", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 zero 0\n", "line 4: joint 'Hips' OFFSET 'zero' is not a number"},
         Malformed{"nan_value", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Yrotation Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 nan 0\n",
                   "line 10: frame 0 value 2 'nan' is not finite"},
+        Malformed{"huge_rotation", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Yrotation Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 7.2e67 0\n",
+                  "line 10: frame 0 value 2 7.2e+67 is out of range"},
+        Malformed{"huge_offset", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 -1e39 0\n", "line 4: joint 'Hips' OFFSET -1e+39 is out of range"},
         Malformed{"short_frame", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Yrotation Xrotation\n}\nMOTION\nFrames: 2\nFrame Time: 0.1\n0 0 0\n0 0\n",
                   "frame 1 ends after 2 of its 3 values"},
         Malformed{"extra_values", "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Yrotation Xrotation\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n7\n",
@@ -202,6 +205,12 @@ TEST(JointMaps, FromAFile) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("'LeftThigh' is not a joint drape drives"), std::string::npos) << e.what();
+  }
+  try {
+    parse_joint_map(R"({"Hips": 1e999})", "map.json", names);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not JSON"), std::string::npos) << e.what();
   }
   try {
     parse_joint_map(R"({"Hips": "root"})", "map.json", names);

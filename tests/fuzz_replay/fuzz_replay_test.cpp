@@ -70,6 +70,12 @@ void replay_garment_corpus(const std::string& target, GarmentFormat format) {
     });
 }
 
+// What fuzz_bvh does with an input: a joint map when it starts as a JSON object, else a BVH file.
+bool check_motion(const std::string& text, const std::string& source) {
+  return drape::fuzz::is_joint_map(text) ? drape::fuzz::check_joint_map(text, source)
+                                         : drape::fuzz::check_motion_file(text, source);
+}
+
 std::optional<MeshFormat> mesh_format_by_extension(const fs::path& f) {
   const std::string ext = f.extension().string();
   if (ext == ".obj") return MeshFormat::Obj;
@@ -87,6 +93,17 @@ TEST(FuzzCorpus, Gltf) { replay_mesh_corpus("gltf", MeshFormat::Gltf); }
 TEST(FuzzCorpus, GarmentJson) { replay_garment_corpus("garment_json", GarmentFormat::DrapeJson); }
 TEST(FuzzCorpus, GarmentCode) { replay_garment_corpus("garmentcode", GarmentFormat::GarmentCode); }
 TEST(FuzzCorpus, Dxf) { replay_garment_corpus("dxf", GarmentFormat::Dxf); }
+TEST(FuzzCorpus, Bvh) {
+  const auto files = files_in(kCorpus / "fuzz" / "bvh");
+  ASSERT_FALSE(files.empty()) << "no corpus in tests/corpus/fuzz/bvh";
+  for (const fs::path& f : files) replay(f, [&](const std::string& text) { return check_motion(text, f.string()); });
+}
+TEST(FuzzCorpus, Web) {
+  const auto files = files_in(kCorpus / "fuzz" / "web");
+  ASSERT_FALSE(files.empty()) << "no corpus in tests/corpus/fuzz/web";
+  for (const fs::path& f : files)
+    replay(f, [&](const std::string& input) { return drape::fuzz::check_web_request(input).value_or(false); });
+}
 
 // The hand-made seeds are good files: each reads and round-trips through every writer.
 TEST(FuzzCorpus, SeedsReadAndRoundTrip) {
@@ -100,6 +117,42 @@ TEST(FuzzCorpus, SeedsReadAndRoundTrip) {
       ++checked;
     }
   EXPECT_GE(checked, 6u);
+}
+
+// The hand-made motion seeds are good files (BVH and joint maps): each reads and retargets.
+TEST(FuzzCorpus, MotionSeedsRead) {
+  const auto files = files_in(fs::path(DRAPE_SOURCE_DIR) / "fuzz" / "seeds" / "bvh");
+  for (const fs::path& f : files)
+    EXPECT_EQ(replay(f, [&](const std::string& text) { return check_motion(text, f.string()); }), std::optional<bool>(true))
+        << f << " was refused";
+  EXPECT_GE(files.size(), 5u);
+}
+
+// The hand-made request seeds: those named refused_* end in a 4xx RequestError, every other one is taken.
+TEST(FuzzCorpus, WebSeedsAnswerAsNamed) {
+  const auto files = files_in(fs::path(DRAPE_SOURCE_DIR) / "fuzz" / "seeds" / "web");
+  for (const fs::path& f : files) {
+    const bool refused = f.filename().string().starts_with("refused_");
+    EXPECT_EQ(replay(f, [&](const std::string& input) { return drape::fuzz::check_web_request(input); }),
+              std::optional<bool>(!refused))
+        << f;
+  }
+  EXPECT_GE(files.size(), 5u);
+}
+
+// Motion files and requests that once broke a property the checks hold (tests/corpus/findings/bvh,
+// tests/corpus/findings/web, named for the defect): each now passes its check, read or refused.
+TEST(FuzzCorpus, FixedMotionAndRequestFindingsHold) {
+  size_t checked = 0;
+  for (const fs::path& f : files_in(kCorpus / "findings" / "bvh")) {
+    replay(f, [&](const std::string& text) { return check_motion(text, f.string()); });
+    ++checked;
+  }
+  for (const fs::path& f : files_in(kCorpus / "findings" / "web")) {
+    replay(f, [&](const std::string& input) { return drape::fuzz::check_web_request(input).value_or(false); });
+    ++checked;
+  }
+  EXPECT_GT(checked, 0u);
 }
 
 // Garment files that once broke a property the fuzz checks hold (tests/corpus/findings, named for

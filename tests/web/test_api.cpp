@@ -143,6 +143,7 @@ TEST_F(WebApi, BadMeasurementsAreRefusedSayingWhy) {
       {R"({"measurements": {"height": 5.0}})", "height"},
       {R"({"measurements": [1.7]})", "measurements"},
       {R"({"measurements": {"underbust": 1.0, "bust": 0.8}})", "measurements"},
+      {R"({"measurements": {"height=1.7,waist": 0.8}})", "height=1.7,waist"},
   };
   for (const auto& k : cases) {
     const auto r = c.Post("/api/bodies", k.body, "application/json");
@@ -240,6 +241,15 @@ TEST_F(WebApi, BadUploadsAreRefusedSayingWhyWithoutServerPaths) {
   ASSERT_TRUE(units);
   EXPECT_EQ(units->status, 400);
   EXPECT_TRUE(error_of(units).starts_with("units")) << error_of(units);
+  // A field that is not UTF-8 is quoted back with its bad bytes replaced (the answer is JSON), and
+  // the server keeps serving.
+  const auto not_utf8 = upload(c, "v 0 0 0\n", "body.obj", "furlong\xD5");
+  ASSERT_TRUE(not_utf8);
+  EXPECT_EQ(not_utf8->status, 400);
+  EXPECT_TRUE(error_of(not_utf8).starts_with("units")) << error_of(not_utf8);
+  const auto alive = c.Get("/api/health");
+  ASSERT_TRUE(alive);
+  EXPECT_EQ(alive->status, 200);
   const auto no_file = c.Post("/api/bodies", httplib::MultipartFormDataItems{{"units", "m", "", ""}});
   ASSERT_TRUE(no_file);
   EXPECT_EQ(no_file->status, 400);

@@ -112,31 +112,14 @@ Image shadow_picture(const CusickResult& r, double specimen_radius, int pixels) 
     uint8_t* p = image.pixel(x, y);
     for (int k = 0; k < 3; ++k) p[k] = static_cast<uint8_t>(std::lround(255.0f * linear_to_srgb(linear[k])));
   };
-  // The shadow: every projected triangle filled (the picture's y is the scene's z).
-  const std::vector<Vec3f>& x = r.specimen.state.x;
+  // The shadow, one cell per pixel (the picture's y is the scene's z).
+  const double cell = 1.0 / scale, corner = -centre * cell;
+  const std::vector<uint8_t> shadow =
+      shadow_raster(r.specimen.state.x, r.specimen.model.triangles, corner, corner, cell, size, size);
   const Vec3f shade = srgb8(70, 78, 96);
-  for (const Tri& t : r.specimen.model.triangles) {
-    Vec2d v[3];
-    for (int k = 0; k < 3; ++k) v[k] = Vec2d(centre + scale * x[t[k]].x(), centre + scale * x[t[k]].z());
-    const double area2 = (v[1] - v[0]).x() * (v[2] - v[0]).y() - (v[1] - v[0]).y() * (v[2] - v[0]).x();
-    if (std::abs(area2) < 1e-12) continue;
-    const double sign = area2 > 0 ? 1 : -1;
-    const int x0 = static_cast<int>(std::floor(std::min({v[0].x(), v[1].x(), v[2].x()})));
-    const int x1 = static_cast<int>(std::ceil(std::max({v[0].x(), v[1].x(), v[2].x()})));
-    const int y0 = static_cast<int>(std::floor(std::min({v[0].y(), v[1].y(), v[2].y()})));
-    const int y1 = static_cast<int>(std::ceil(std::max({v[0].y(), v[1].y(), v[2].y()})));
-    for (int py = y0; py <= y1; ++py)
-      for (int px = x0; px <= x1; ++px) {
-        const Vec2d p(px + 0.5, py + 0.5);
-        bool inside = true;
-        for (int k = 0; k < 3 && inside; ++k) {
-          const Vec2d& a = v[k];
-          const Vec2d& b = v[(k + 1) % 3];
-          inside = sign * ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) >= 0;
-        }
-        if (inside) put(px, py, shade);
-      }
-  }
+  for (int py = 0; py < size; ++py)
+    for (int px = 0; px < size; ++px)
+      if (shadow[static_cast<size_t>(py) * static_cast<size_t>(size) + static_cast<size_t>(px)]) put(px, py, shade);
   // The flat specimen's outline and the support disc.
   const auto circle = [&](double radius, const Vec3f& colour) {
     const int steps = static_cast<int>(8 * radius * scale) + 16;
@@ -215,8 +198,9 @@ void run_cusick_scene(const SceneArgs& a) {
   const std::filesystem::path dir(a.out);
   if (g.status != StepStatus::NonFinite) {
     Scene gltf;
-    add_mesh_node(gltf, g.mesh(), "cloth");
-    add_mesh_node(gltf, r.support->mesh(), "body");
+    const Mesh cloth = g.mesh(), support = r.support->mesh();
+    add_mesh_node(gltf, cloth, "cloth");
+    add_mesh_node(gltf, support, "body");
     write_scene(dir / "scene.glb", gltf);
     RenderOptions view;
     view.width = 640;
@@ -225,8 +209,7 @@ void run_cusick_scene(const SceneArgs& a) {
     view.elevation_degrees = 25.0f;
     view.floor_shadow = false;
     view.view_labels = false;
-    Mesh cloth = g.mesh();
-    const Image side = render_views({body_item(r.support->mesh()), garment_item(cloth, 0)}, view);
+    const Image side = render_views({body_item(support), garment_item(cloth, 0)}, view);
     char caption[160];
     std::snprintf(caption, sizeof caption, "%s: drape coefficient %.1f %%, %d nodes", o.fabric.name.c_str(),
                   100 * r.drape_coefficient, r.nodes);

@@ -42,6 +42,11 @@ struct CusickResult {
 // measures its shadow. Throws InputError("cusick", ...) for diameters or spacing out of range.
 CusickResult run_cusick(const CusickOptions& options, const DressProgressCallback& progress = {});
 
+// The shadow the triangles cast straight down on a grid of nx x nz square cells of side `cell`,
+// the first cell's corner at (x0, z0): 1 where a cell's centre lies in a projected triangle.
+std::vector<uint8_t> shadow_raster(std::span<const Vec3f> positions, std::span<const Tri> triangles, double x0, double z0,
+                                   double cell, int nx, int nz);
+
 // Area (m^2) of the shadow the triangles cast straight down (the union of their projections on the
 // horizontal plane), by rasterising it at `cell` metres.
 double shadow_area(std::span<const Vec3f> positions, std::span<const Tri> triangles, double cell = 2.5e-4);

@@ -81,6 +81,34 @@ int count_nodes(const std::vector<double>& radius) {
 
 }  // namespace
 
+std::vector<uint8_t> shadow_raster(std::span<const Vec3f> positions, std::span<const Tri> triangles, double x0, double z0,
+                                   double cell, int nx, int nz) {
+  std::vector<uint8_t> covered(static_cast<size_t>(std::max(nx, 0)) * static_cast<size_t>(std::max(nz, 0)), 0);
+  if (!(cell > 0)) return covered;
+  for (const Tri& t : triangles) {
+    const Vec2d a(positions[t[0]].x(), positions[t[0]].z());
+    const Vec2d b(positions[t[1]].x(), positions[t[1]].z());
+    const Vec2d c(positions[t[2]].x(), positions[t[2]].z());
+    const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    if (std::abs(area2) < 1e-18) continue;
+    const int ix0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - x0) / cell - 0.5)));
+    const int ix1 = std::min(nx - 1, static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - x0) / cell - 0.5)));
+    const int iz0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - z0) / cell - 0.5)));
+    const int iz1 = std::min(nz - 1, static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - z0) / cell - 0.5)));
+    const double sign = area2 > 0 ? 1.0 : -1.0;
+    const auto edge = [&](const Vec2d& p, const Vec2d& q, const Vec2d& r) {
+      return sign * ((q - p).x() * (r - p).y() - (q - p).y() * (r - p).x());
+    };
+    for (int iz = iz0; iz <= iz1; ++iz)
+      for (int ix = ix0; ix <= ix1; ++ix) {
+        const Vec2d p(x0 + (ix + 0.5) * cell, z0 + (iz + 0.5) * cell);
+        if (edge(a, b, p) >= 0 && edge(b, c, p) >= 0 && edge(c, a, p) >= 0)
+          covered[static_cast<size_t>(iz) * static_cast<size_t>(nx) + static_cast<size_t>(ix)] = 1;
+      }
+  }
+  return covered;
+}
+
 double shadow_area(std::span<const Vec3f> positions, std::span<const Tri> triangles, double cell) {
   if (positions.empty() || triangles.empty() || !(cell > 0)) return 0;
   double lo_x = positions[0].x(), hi_x = lo_x, lo_z = positions[0].z(), hi_z = lo_z;
@@ -92,31 +120,8 @@ double shadow_area(std::span<const Vec3f> positions, std::span<const Tri> triang
   }
   const int nx = static_cast<int>(std::ceil((hi_x - lo_x) / cell)) + 1;
   const int nz = static_cast<int>(std::ceil((hi_z - lo_z) / cell)) + 1;
-  // A cell is in the shadow when its centre lies in a projected triangle (edges included).
-  std::vector<uint8_t> covered(static_cast<size_t>(nx) * static_cast<size_t>(nz), 0);
-  for (const Tri& t : triangles) {
-    const Vec2d a(positions[t[0]].x(), positions[t[0]].z());
-    const Vec2d b(positions[t[1]].x(), positions[t[1]].z());
-    const Vec2d c(positions[t[2]].x(), positions[t[2]].z());
-    const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    if (std::abs(area2) < 1e-18) continue;
-    const int x0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - lo_x) / cell - 0.5)));
-    const int x1 = std::min(nx - 1, static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - lo_x) / cell - 0.5)));
-    const int z0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - lo_z) / cell - 0.5)));
-    const int z1 = std::min(nz - 1, static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - lo_z) / cell - 0.5)));
-    const double sign = area2 > 0 ? 1.0 : -1.0;
-    const auto edge = [&](const Vec2d& p, const Vec2d& q, const Vec2d& r) {
-      return sign * ((q - p).x() * (r - p).y() - (q - p).y() * (r - p).x());
-    };
-    for (int iz = z0; iz <= z1; ++iz)
-      for (int ix = x0; ix <= x1; ++ix) {
-        const Vec2d p(lo_x + (ix + 0.5) * cell, lo_z + (iz + 0.5) * cell);
-        if (edge(a, b, p) >= 0 && edge(b, c, p) >= 0 && edge(c, a, p) >= 0)
-          covered[static_cast<size_t>(iz) * static_cast<size_t>(nx) + static_cast<size_t>(ix)] = 1;
-      }
-  }
   size_t count = 0;
-  for (uint8_t c : covered) count += c;
+  for (uint8_t c : shadow_raster(positions, triangles, lo_x, lo_z, cell, nx, nz)) count += c;
   return static_cast<double>(count) * cell * cell;
 }
 

@@ -50,29 +50,43 @@ std::vector<std::pair<std::string_view, Vec3f>> Landmarks::named() const {
 
 namespace body {
 
-std::optional<SectionPiece> torso_section(const Slicer& mesh, float y) {
-  auto pieces = slice(mesh, horizontal_plane(y));
-  const int i = piece_straddling(pieces, 0.0f);
-  if (i < 0) return std::nullopt;
-  return std::move(pieces[static_cast<size_t>(i)]);
-}
+std::optional<SectionPiece> torso_section(const Slicer& mesh, float y) { return straddling_piece(mesh, y); }
 
 float torso_girth(const Slicer& mesh, float y) {
-  auto s = torso_section(mesh, y);
-  return s ? hull_perimeter(s->points) : 0.0f;
+  auto s = straddling_outline(mesh, y);
+  return s ? hull_perimeter(std::move(s->points)) : 0.0f;
 }
 
-std::optional<SectionPiece> leg_section(const Slicer& mesh, float y, int side) {
-  auto pieces = slice(mesh, horizontal_plane(y));
-  // The leg is the piece on that side nearest the midline (hands hang further out).
+namespace {
+
+// Of a section's pieces, the leg on one side: the piece on that side nearest the midline (hands
+// hang further out); -1 when none.
+int leg_piece(const std::vector<SectionPiece>& pieces, int side) {
   int best = -1;
   for (size_t i = 0; i < pieces.size(); ++i) {
     const float cx = pieces[i].centroid.x() * static_cast<float>(side);
     if (cx <= 0 || pieces[i].min.x() * static_cast<float>(side) < -0.02f) continue;
     if (best < 0 || cx < pieces[static_cast<size_t>(best)].centroid.x() * static_cast<float>(side)) best = static_cast<int>(i);
   }
+  return best;
+}
+
+}  // namespace
+
+std::optional<SectionPiece> leg_section(const Slicer& mesh, float y, int side) {
+  auto pieces = slice(mesh, horizontal_plane(y));
+  const int best = leg_piece(pieces, side);
   if (best < 0) return std::nullopt;
   return std::move(pieces[static_cast<size_t>(best)]);
+}
+
+std::array<std::optional<SectionPiece>, 2> leg_sections(const Slicer& mesh, float y) {
+  auto pieces = slice(mesh, horizontal_plane(y));
+  std::array<std::optional<SectionPiece>, 2> legs;
+  const int left = leg_piece(pieces, +1), right = leg_piece(pieces, -1);
+  if (left >= 0) legs[0] = pieces[static_cast<size_t>(left)];
+  if (right >= 0) legs[1] = std::move(pieces[static_cast<size_t>(right)]);
+  return legs;
 }
 
 SlicePlane limb_plane(const Vec3f& point, const Vec3f& axis) {
@@ -95,6 +109,13 @@ float limb_girth(const Slicer& mesh, const Vec3f& point, const Vec3f& axis) {
   return s ? hull_perimeter(s->points) : 0.0f;
 }
 
+bool torso_below_bust(const Slicer& mesh, const Landmarks& lm, float height) {
+  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+  for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f)  // find_underbust's levels
+    if (straddling_outline(mesh, y)) return true;
+  return false;
+}
+
 bool find_underbust(const Slicer& mesh, Landmarks& lm, float height) {
   const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
   // Underbust: going down from the bust, the first dip of the front profile (the fold under the
@@ -104,7 +125,7 @@ bool find_underbust(const Slicer& mesh, Landmarks& lm, float height) {
   {
     float min_front = 1e9f, min_y = -1.0f, top_front = -1e9f;
     for (float y = bust_y; y > bust_y - 0.1f * height; y -= 0.002f) {
-      auto s = torso_section(mesh, y);
+      auto s = straddling_outline(mesh, y);
       if (!s) continue;
       top_front = std::max(top_front, s->max.y());
       if (s->max.y() < min_front) {
@@ -117,7 +138,7 @@ bool find_underbust(const Slicer& mesh, Landmarks& lm, float height) {
     if (min_y < 0) return false;
     if (top_front - min_front < 0.005f) {
       min_y = bust_y - 0.04f * height + 0.01f;
-      if (auto s = torso_section(mesh, min_y - 0.01f)) min_front = s->max.y();
+      if (auto s = straddling_outline(mesh, min_y - 0.01f)) min_front = s->max.y();
     }
     lm.underbust = Vec3f(0.0f, min_y - 0.01f, min_front);
   }
@@ -133,9 +154,9 @@ WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm) {
     float best = 1e9f;
     const float from = crotch_y + 0.3f * (low_armpit - crotch_y);
     for (float y = from; y < crotch_y + 0.7f * (low_armpit - crotch_y); y += 0.003f) {
-      auto s = torso_section(mesh, y);
+      auto s = straddling_outline(mesh, y);
       if (!s) continue;
-      const float g = hull_perimeter(s->points);
+      const float g = hull_perimeter(std::move(s->points));
       if (g < best) {
         best = g;
         lm.waist = Vec3f(0.0f, y, s->max.y());
@@ -147,9 +168,9 @@ WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm) {
   {
     float best = 0;
     for (float y = crotch_y + 0.015f; y < lm.waist.y(); y += 0.003f) {
-      auto s = torso_section(mesh, y);
+      auto s = straddling_outline(mesh, y);
       if (!s) continue;
-      const float g = hull_perimeter(s->points);
+      const float g = hull_perimeter(std::move(s->points));
       if (g > best) {
         best = g;
         lm.hip = Vec3f(0.0f, y, s->min.y());
@@ -263,7 +284,10 @@ ArmLandmarks find_arm(const Slicer& mesh, int side, float armpit_y, const Sectio
 }  // namespace
 
 Landmarks find_landmarks(const Mesh& input, const std::string& source) {
-  const Slicer mesh(input);  // indexed once: the search below slices it thousands of times
+  return body::find_landmarks(Slicer(input), source);  // indexed once: the search slices it thousands of times
+}
+
+Landmarks body::find_landmarks(const Slicer& mesh, const std::string& source) {
   if (mesh.positions.empty() || mesh.triangles.empty()) throw InputError(source, "no mesh");
   Landmarks lm;
   const Bounds box = bounds(mesh.positions);
@@ -384,18 +408,23 @@ Landmarks find_landmarks(const Mesh& input, const std::string& source) {
 
   // Ankles: the narrowest leg section between 3 % and 12 % of the height; knees at 57 % of the way
   // from ankle to crotch (tibia : femur proportions).
-  for (int side : {+1, -1}) {
-    float best = 1e9f;
-    Vec3f ankle = Vec3f::Zero();
-    for (float y = 0.03f * height; y < 0.12f * height; y += 0.003f) {
-      auto s = leg_section(mesh, y, side);
-      if (!s) continue;
-      const float g = hull_perimeter(s->points);
-      if (g < best) {
-        best = g;
-        ankle = Vec3f(s->centroid.x(), y, s->centroid.y());
+  // Both legs from the same sections.
+  std::array<float, 2> best_girth{1e9f, 1e9f};
+  std::array<Vec3f, 2> ankles{Vec3f::Zero(), Vec3f::Zero()};
+  for (float y = 0.03f * height; y < 0.12f * height; y += 0.003f) {
+    auto legs = leg_sections(mesh, y);
+    for (size_t k = 0; k < 2; ++k) {
+      if (!legs[k]) continue;
+      const float g = hull_perimeter(legs[k]->points);
+      if (g < best_girth[k]) {
+        best_girth[k] = g;
+        ankles[k] = Vec3f(legs[k]->centroid.x(), y, legs[k]->centroid.y());
       }
     }
+  }
+  for (int side : {+1, -1}) {
+    const float best = best_girth[side > 0 ? 0 : 1];
+    const Vec3f ankle = ankles[side > 0 ? 0 : 1];
     if (best > 1e8f) fail(source, "cannot find the ankles");
     const float knee_y = ankle.y() + 0.57f * (crotch_y - ankle.y());
     auto k = leg_section(mesh, knee_y, side);

@@ -139,6 +139,7 @@ MhModel decode_makehuman(std::span<const unsigned char> bytes) {
       i = r.get<uint16_t>();
       if (i >= m.body_vertices) throw std::runtime_error("MakeHuman pack: a triangle outside the body");
     }
+  m.topology = SliceTopology(m.triangles);
   const uint32_t targets = r.count(1024);
   m.targets.resize(targets);
   for (auto& t : m.targets) {

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "body/slicing.hpp"
 #include "drape/body.hpp"
 
 namespace drape::body {
@@ -38,6 +39,7 @@ struct MhModel {
   uint32_t body_vertices = 0;  // the mesh is vertices [0, body_vertices); helpers follow
   std::vector<Vec3f> base;     // body + helper vertices, metres, base.obj's frame (+Y up, facing +Z)
   std::vector<Tri> triangles;  // closed, genus 0, counter-clockwise from outside
+  SliceTopology topology;      // of the triangles, for slicing the bodies made of them
   std::vector<MhTarget> targets;
   std::vector<MhSkeleton> skeletons;
 

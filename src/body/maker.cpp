@@ -181,11 +181,18 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
 
   Keys keys;
   std::vector<std::string_view> key_names;
-  for (const auto& row : measurement_table())
-    if (const auto it = request.find(row.key); it != request.end()) {
-      keys.emplace_back(row.field, it->second);
-      key_names.push_back(row.key);
+  body::MeasurementSet measured;  // only the requested keys are measured
+  for (size_t row = 0; row < measurement_table().size(); ++row)
+    if (const auto it = request.find(measurement_table()[row].key); it != request.end()) {
+      keys.emplace_back(measurement_table()[row].field, it->second);
+      key_names.push_back(measurement_table()[row].key);
+      measured.set(row);
     }
+  const body::SliceTopology& topology = model.topology;  // every candidate body has the same triangles
+  auto search = [&](const Mesh& mesh) { return body::find_landmarks(body::Slicer(mesh, &topology), "made body"); };
+  auto measure = [&](const Mesh& mesh, const Landmarks& lm) {
+    return residuals(body::measure_body(body::Slicer(mesh, &topology), lm, measured), keys);
+  };
   std::vector<Unknown> unknowns{unknown(0), unknown(1), unknown(2)};
   for (int m = 0; m < body::kMhMeasureCount; ++m)
     if (request.count(body::mh_measure_key(m))) unknowns.push_back(unknown(3 + m));
@@ -239,11 +246,11 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
     const Mesh& mesh = shaper(shape_at(x));
     std::optional<Landmarks> lm;
     try {
-      lm = find_landmarks(mesh, "made body");
+      lm = search(mesh);
     } catch (const InputError&) {
       if (round == 0) throw InputError("measurements", "no standing body could be made at this height");
     }
-    Eigen::VectorXd r = lm ? residuals(measure_body(mesh, *lm), keys) : Eigen::VectorXd::Constant(k, 1e3);
+    Eigen::VectorXd r = lm ? measure(mesh, *lm) : Eigen::VectorXd::Constant(k, 1e3);
     const double miss = r.cwiseAbs().maxCoeff();
     if (miss < best_miss) {
       best_miss = miss;
@@ -260,16 +267,19 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
     const Pins pins = pin(mesh, *lm);
     // The underbust, the waist and the hip are searched again (their searches are cheap): the
     // waist is the narrowest level and the hip the fullest, so widening a pinned waist could leave
-    // a narrower level elsewhere, and a flat chest's underbust flips between its two rules.
+    // a narrower level elsewhere, and a flat chest's underbust flips between its two rules. An
+    // underbust that is not requested is not searched for: only whether there is one matters.
+    // Only the requested keys are measured.
     auto pinned = [&](const Eigen::VectorXd& v) {
       const Mesh& m = shaper(shape_at(v));
       Landmarks at = place(pins, m);
       Landmarks searched = at;
-      const body::Slicer slicer(m);
-      if (body::find_underbust(slicer, searched, at.crown.y()) &&
-          body::find_waist_and_hip(slicer, searched) == body::WaistAndHip::kFound)
+      const body::Slicer slicer(m, &topology);
+      const bool below_bust = request.count("underbust") ? body::find_underbust(slicer, searched, at.crown.y())
+                                                      : body::torso_below_bust(slicer, searched, at.crown.y());
+      if (below_bust && body::find_waist_and_hip(slicer, searched) == body::WaistAndHip::kFound)
         at = searched;
-      return residuals(measure_body(m, at), keys);
+      return residuals(body::measure_body(slicer, at, measured), keys);
     };
     auto fresh_jacobian = [&]() {
       jac.resize(k, n);
@@ -322,7 +332,7 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
   // on the real measurements, with the slope the solve last saw.
   for (int polish = 0; polish < kPolish && best_miss > kTolerance && jac.size() > 0; ++polish) {
     const Mesh& mesh = shaper(shape_at(best_x));
-    const Eigen::VectorXd r = residuals(measure_body(mesh, find_landmarks(mesh, "made body")), keys);
+    const Eigen::VectorXd r = measure(mesh, search(mesh));
     Eigen::Index worst = 0;
     r.cwiseAbs().maxCoeff(&worst);
     const Eigen::Index u = own[static_cast<size_t>(worst)];
@@ -335,11 +345,11 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
       const Mesh& m = shaper(shape_at(y));
       std::optional<Landmarks> lm;
       try {
-        lm = find_landmarks(m, "made body");
+        lm = search(m);
       } catch (const InputError&) {
         continue;
       }
-      const double miss = residuals(measure_body(m, *lm), keys).cwiseAbs().maxCoeff();
+      const double miss = measure(m, *lm).cwiseAbs().maxCoeff();
       if (miss < best_miss) {
         best_miss = miss;
         best_x = y;

@@ -60,50 +60,61 @@ float back_profile_length(const Slicer& mesh, float from_y, float to_y, float fr
   return length;
 }
 
-float thigh_girth(const Slicer& mesh, float crotch_y, int side) {
-  // Fullest leg section in the 8 cm below the crotch.
-  float best = 0;
+// Mean of both legs' girths: each the fullest leg section in the 8 cm below the crotch.
+float thigh_girth(const Slicer& mesh, float crotch_y) {
+  std::array<float, 2> best{0.0f, 0.0f};
   for (float y = crotch_y - 0.003f; y > crotch_y - 0.08f; y -= 0.003f) {
-    auto s = leg_section(mesh, y, side);
-    if (s) best = std::max(best, hull_perimeter(s->points));
+    auto legs = leg_sections(mesh, y);
+    for (size_t k = 0; k < 2; ++k)
+      if (legs[k]) best[k] = std::max(best[k], hull_perimeter(std::move(legs[k]->points)));
   }
-  return best;
+  return 0.5f * (best[0] + best[1]);
 }
 
 }  // namespace
 
-Measurements measure_body(const Mesh& input, const Landmarks& lm) {
-  const Slicer mesh(input);  // indexed once for the many sections below
+Measurements body::measure_body(const Slicer& mesh, const Landmarks& lm, MeasurementSet which) {
+  // Bits in measurement_table()'s order.
+  enum : size_t { kHeight, kNeck, kBust, kUnderbust, kWaist, kHips, kThigh, kUpperArm, kWrist, kInseam, kArmLength,
+                  kShoulderWidth, kBackLength };
   Measurements m;
-  m.height = lm.crown.y() - bounds(mesh.positions).min.y();
-  m.neck = torso_girth_at(mesh, lm.neck.y());
-  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
-  // Bust (women) or chest (men) girth: the fullest torso section from the bust points up to 2 cm
-  // under the armpits, so it reads the bust of a woman and the chest under the arms of a man.
-  const float chest_top = std::min(lm.left_armpit.y(), lm.right_armpit.y()) - 0.02f;
-  m.bust = torso_girth_at(mesh, bust_y);
-  for (float y = bust_y + 0.003f; y <= chest_top; y += 0.003f) m.bust = std::max(m.bust, torso_girth_at(mesh, y));
-  m.underbust = torso_girth_at(mesh, lm.underbust.y());
-  m.waist = torso_girth_at(mesh, lm.waist.y());
-  m.hips = torso_girth_at(mesh, lm.hip.y());
-  m.thigh = 0.5f * (thigh_girth(mesh, lm.crotch.y(), +1) + thigh_girth(mesh, lm.crotch.y(), -1));
-  m.inseam = lm.crotch.y();
+  if (which[kHeight]) m.height = lm.crown.y() - bounds(mesh.positions).min.y();
+  if (which[kNeck]) m.neck = torso_girth_at(mesh, lm.neck.y());
+  if (which[kBust]) {
+    const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+    // Bust (women) or chest (men) girth: the fullest torso section from the bust points up to 2 cm
+    // under the armpits, so it reads the bust of a woman and the chest under the arms of a man.
+    const float chest_top = std::min(lm.left_armpit.y(), lm.right_armpit.y()) - 0.02f;
+    m.bust = torso_girth_at(mesh, bust_y);
+    for (float y = bust_y + 0.003f; y <= chest_top; y += 0.003f) m.bust = std::max(m.bust, torso_girth_at(mesh, y));
+  }
+  if (which[kUnderbust]) m.underbust = torso_girth_at(mesh, lm.underbust.y());
+  if (which[kWaist]) m.waist = torso_girth_at(mesh, lm.waist.y());
+  if (which[kHips]) m.hips = torso_girth_at(mesh, lm.hip.y());
+  if (which[kThigh]) m.thigh = thigh_girth(mesh, lm.crotch.y());
+  if (which[kInseam]) m.inseam = lm.crotch.y();
 
   // Arms: girths perpendicular to the shoulder->elbow and elbow->wrist directions.
-  auto arm = [&](const Vec3f& shoulder, const Vec3f& elbow, const Vec3f& wrist, const Vec3f& tip) {
-    const Vec3f mid_upper = 0.5f * (shoulder + elbow);
-    const float upper = limb_girth(mesh, mid_upper, elbow - shoulder);
-    const float w = limb_girth(mesh, wrist, tip - elbow);
-    return std::array<float, 3>{upper, w, (wrist - shoulder).norm()};
+  auto upper = [&](const Vec3f& shoulder, const Vec3f& elbow) {
+    return limb_girth(mesh, 0.5f * (shoulder + elbow), elbow - shoulder);
   };
-  const auto l = arm(lm.left_shoulder, lm.left_elbow, lm.left_wrist, lm.left_fingertip);
-  const auto r = arm(lm.right_shoulder, lm.right_elbow, lm.right_wrist, lm.right_fingertip);
-  m.upper_arm = 0.5f * (l[0] + r[0]);
-  m.wrist = 0.5f * (l[1] + r[1]);
-  m.arm_length = 0.5f * (l[2] + r[2]);
-  m.shoulder_width = (lm.left_shoulder - lm.right_shoulder).norm();
-  m.back_length = back_profile_length(mesh, lm.waist.y(), lm.neck_base.y(), lm.neck_base.z() + 0.08f);
+  auto wrist = [&](const Vec3f& elbow, const Vec3f& at, const Vec3f& tip) { return limb_girth(mesh, at, tip - elbow); };
+  if (which[kUpperArm])
+    m.upper_arm = 0.5f * (upper(lm.left_shoulder, lm.left_elbow) + upper(lm.right_shoulder, lm.right_elbow));
+  if (which[kWrist])
+    m.wrist = 0.5f * (wrist(lm.left_elbow, lm.left_wrist, lm.left_fingertip) +
+                      wrist(lm.right_elbow, lm.right_wrist, lm.right_fingertip));
+  if (which[kArmLength])
+    m.arm_length = 0.5f * ((lm.left_wrist - lm.left_shoulder).norm() + (lm.right_wrist - lm.right_shoulder).norm());
+  if (which[kShoulderWidth]) m.shoulder_width = (lm.left_shoulder - lm.right_shoulder).norm();
+  if (which[kBackLength])
+    m.back_length = back_profile_length(mesh, lm.waist.y(), lm.neck_base.y(), lm.neck_base.z() + 0.08f);
   return m;
+}
+
+Measurements measure_body(const Mesh& input, const Landmarks& lm) {
+  const body::Slicer mesh(input);  // indexed once for the many sections below
+  return body::measure_body(mesh, lm, body::MeasurementSet().set());
 }
 
 }  // namespace drape

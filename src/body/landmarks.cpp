@@ -296,15 +296,16 @@ Landmarks body::find_landmarks(const Slicer& mesh, const std::string& source) {
     if (p.y() >= height) lm.crown = p;
 
   // Crotch: scanning down from above the hips, the last height whose section straddles x = 0.
+  // (Where only whether there is a section, or its girth or extent, matters, its outline will do.)
   float y_straddle = 0.58f * height;
-  if (!torso_section(mesh, y_straddle)) fail(source, "no torso section at hip height");
+  if (!straddling_outline(mesh, y_straddle)) fail(source, "no torso section at hip height");
   float y_free = y_straddle;
-  while (y_free > 0.25f * height && torso_section(mesh, y_free)) y_free -= 0.005f;
+  while (y_free > 0.25f * height && straddling_outline(mesh, y_free)) y_free -= 0.005f;
   if (y_free <= 0.25f * height) fail(source, "no gap between the legs");
   y_straddle = y_free + 0.005f;
   for (int i = 0; i < 12; ++i) {
     const float mid = 0.5f * (y_free + y_straddle);
-    (torso_section(mesh, mid) ? y_straddle : y_free) = mid;
+    (straddling_outline(mesh, mid) ? y_straddle : y_free) = mid;
   }
   const float crotch_y = y_straddle;
   {
@@ -317,9 +318,10 @@ Landmarks body::find_landmarks(const Slicer& mesh, const std::string& source) {
   float armpit_y[2] = {0, 0};
   std::optional<SectionPiece> below[2];
   {
-    std::optional<SectionPiece> previous = torso_section(mesh, crotch_y + 0.3f * (height - crotch_y));
+    float previous_y = crotch_y + 0.3f * (height - crotch_y);
+    std::optional<SectionPiece> previous = straddling_outline(mesh, previous_y);
     for (float y = crotch_y + 0.3f * (height - crotch_y) + 0.002f; y < 0.92f * height; y += 0.002f) {
-      auto s = torso_section(mesh, y);
+      auto s = straddling_outline(mesh, y);
       if (!s || !previous) break;
       for (int k = 0; k < 2; ++k) {
         if (armpit_y[k] > 0) continue;
@@ -327,35 +329,40 @@ Landmarks body::find_landmarks(const Slicer& mesh, const std::string& source) {
         const float jump = left ? s->max.x() - previous->max.x() : previous->min.x() - s->min.x();
         if (jump > 0.025f) {
           armpit_y[k] = y - 0.002f;
-          below[k] = previous;
+          below[k] = torso_section(mesh, previous_y);  // the piece itself: find_arm reads its points
         }
       }
       if (armpit_y[0] > 0 && armpit_y[1] > 0) break;
       previous = std::move(s);
+      previous_y = y;
     }
   }
   if (armpit_y[0] <= 0 || armpit_y[1] <= 0) fail(source, "cannot find the armpits");
   const float top_armpit = std::max(armpit_y[0], armpit_y[1]);
 
   // Neck: the narrowest section between the armpits and 90 % of the height.
-  float neck_girth = 1e9f;
+  float neck_girth = 1e9f, neck_y = 0.0f;
   for (float y = top_armpit + 0.02f; y < 0.9f * height; y += 0.003f) {
-    auto s = torso_section(mesh, y);
+    auto s = straddling_outline(mesh, y);
     if (!s) continue;
-    const float g = hull_perimeter(s->points);
+    const float g = hull_perimeter(std::move(s->points));
     if (g < neck_girth) {
       neck_girth = g;
-      lm.neck = Vec3f(s->centroid.x(), y, s->centroid.y());
+      neck_y = y;
     }
   }
   if (neck_girth > 1e8f) fail(source, "cannot find the neck");
+  {
+    const auto s = torso_section(mesh, neck_y);  // its centroid
+    lm.neck = Vec3f(s->centroid.x(), neck_y, s->centroid.y());
+  }
   // Neck base: going down from the narrowest neck, where the section has grown by a quarter (the
   // shoulders begin); the cervicale is the back of the midline there.
   {
     float y = lm.neck.y();
     std::optional<SectionPiece> s;
     for (; y > top_armpit; y -= 0.003f) {
-      s = torso_section(mesh, y);
+      s = straddling_outline(mesh, y);
       if (s && hull_perimeter(s->points) > 1.25f * neck_girth) break;
     }
     float back_z = s ? s->min.y() : lm.neck.z();

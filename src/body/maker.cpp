@@ -159,7 +159,13 @@ Body body::mh_body(const MhShape& shape, BodySkeleton skeleton) {
   untangle(b.mesh);  // the toes touch: part them
   const Eigen::Affine3f placed = normalise_body_placement(b.mesh, "made body");
   b.mesh.normals = vertex_normals(b.mesh.positions, b.mesh.triangles);
-  analyse_body(b, "made body");
+  {
+    // analyse_body, on an index that knows the model's triangles
+    const body::Slicer indexed(b.mesh, &model.topology);
+    b.landmarks = body::find_landmarks(indexed, "made body");
+    b.measurements = body::measure_body(indexed, b.landmarks, body::MeasurementSet().set());
+    b.parts = segment_body(b.mesh, b.landmarks);
+  }
   // The skeleton follows the shape: each joint is the mean of its vertex group on this body.
   const body::MhSkeleton& rig = model.skeleton(skeleton == BodySkeleton::CmuMb ? "cmu_mb" : "default");
   for (const auto& j : rig.joints) {
@@ -189,9 +195,9 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
       measured.set(row);
     }
   const body::SliceTopology& topology = model.topology;  // every candidate body has the same triangles
-  auto search = [&](const Mesh& mesh) { return body::find_landmarks(body::Slicer(mesh, &topology), "made body"); };
-  auto measure = [&](const Mesh& mesh, const Landmarks& lm) {
-    return residuals(body::measure_body(body::Slicer(mesh, &topology), lm, measured), keys);
+  auto search = [&](const body::Slicer& mesh) { return body::find_landmarks(mesh, "made body"); };
+  auto measure = [&](const body::Slicer& mesh, const Landmarks& lm) {
+    return residuals(body::measure_body(mesh, lm, measured), keys);
   };
   std::vector<Unknown> unknowns{unknown(0), unknown(1), unknown(2)};
   for (int m = 0; m < body::kMhMeasureCount; ++m)
@@ -244,13 +250,14 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
   for (int round = 0; round < kRounds; ++round) {
     // The real measurements, landmarks searched for.
     const Mesh& mesh = shaper(shape_at(x));
+    const body::Slicer indexed(mesh, &topology);
     std::optional<Landmarks> lm;
     try {
-      lm = search(mesh);
+      lm = search(indexed);
     } catch (const InputError&) {
       if (round == 0) throw InputError("measurements", "no standing body could be made at this height");
     }
-    Eigen::VectorXd r = lm ? measure(mesh, *lm) : Eigen::VectorXd::Constant(k, 1e3);
+    Eigen::VectorXd r = lm ? measure(indexed, *lm) : Eigen::VectorXd::Constant(k, 1e3);
     const double miss = r.cwiseAbs().maxCoeff();
     if (miss < best_miss) {
       best_miss = miss;
@@ -331,8 +338,8 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
   // waist), the rounds can end between them: the worst key is then moved alone by its own unknown,
   // on the real measurements, with the slope the solve last saw.
   for (int polish = 0; polish < kPolish && best_miss > kTolerance && jac.size() > 0; ++polish) {
-    const Mesh& mesh = shaper(shape_at(best_x));
-    const Eigen::VectorXd r = measure(mesh, search(mesh));
+    const body::Slicer indexed(shaper(shape_at(best_x)), &topology);
+    const Eigen::VectorXd r = measure(indexed, search(indexed));
     Eigen::Index worst = 0;
     r.cwiseAbs().maxCoeff(&worst);
     const Eigen::Index u = own[static_cast<size_t>(worst)];
@@ -342,14 +349,14 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
       Eigen::VectorXd y = best_x;
       y[u] = std::clamp(y[u] - fraction * r[worst] / jac(worst, u), double{unknowns[static_cast<size_t>(u)].lo},
                         double{unknowns[static_cast<size_t>(u)].hi});
-      const Mesh& m = shaper(shape_at(y));
+      const body::Slicer candidate(shaper(shape_at(y)), &topology);
       std::optional<Landmarks> lm;
       try {
-        lm = search(m);
+        lm = search(candidate);
       } catch (const InputError&) {
         continue;
       }
-      const double miss = measure(m, *lm).cwiseAbs().maxCoeff();
+      const double miss = measure(candidate, *lm).cwiseAbs().maxCoeff();
       if (miss < best_miss) {
         best_miss = miss;
         best_x = y;

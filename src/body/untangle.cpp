@@ -81,21 +81,48 @@ std::vector<std::pair<uint32_t, uint32_t>> crossing_triangles(const Mesh& mesh, 
   }
   for (uint32_t t : focus) cell_range(t, 1, [&](uint64_t k) { wanted.push_back(k); });
   std::sort(wanted.begin(), wanted.end());
-  for (uint32_t t = 0; t < t_count; ++t)
-    cell_range(t, 0, [&](uint64_t k) {
-      if (focus.empty() || std::binary_search(wanted.begin(), wanted.end(), k)) cells.emplace_back(k, t);
-    });
-  std::sort(cells.begin(), cells.end());
+  // (cell, triangle) entries, sorted by cell then triangle. Where the cells' coordinates fit 16 bits
+  // and the triangles' indices too (a body's always do), an entry is one integer, which sorts several
+  // times faster than a pair; the order is the same.
+  bool packed = t_count < (size_t{1} << 16);
+  for (uint32_t t = 0; t < t_count && packed; ++t)
+    packed = lo[t].minCoeff() >= -32768 && hi[t].maxCoeff() < 32768;
+  auto key16 = [](int x, int y, int z) {
+    return (static_cast<uint64_t>(x + 32768) << 32) | (static_cast<uint64_t>(y + 32768) << 16) |
+           static_cast<uint64_t>(z + 32768);
+  };
+  std::vector<uint64_t> entries;  // packed: key16 << 16 | triangle
+  if (packed) {
+    entries.reserve(4 * t_count);
+    for (uint32_t t = 0; t < t_count; ++t)
+      for (int x = lo[t].x(); x <= hi[t].x(); ++x)
+        for (int y = lo[t].y(); y <= hi[t].y(); ++y)
+          for (int z = lo[t].z(); z <= hi[t].z(); ++z)
+            if (focus.empty() || std::binary_search(wanted.begin(), wanted.end(), key(x, y, z)))
+              entries.push_back((key16(x, y, z) << 16) | t);
+    std::sort(entries.begin(), entries.end());
+  } else {
+    for (uint32_t t = 0; t < t_count; ++t)
+      cell_range(t, 0, [&](uint64_t k) {
+        if (focus.empty() || std::binary_search(wanted.begin(), wanted.end(), k)) cells.emplace_back(k, t);
+      });
+    std::sort(cells.begin(), cells.end());
+  }
+  const size_t count = packed ? entries.size() : cells.size();
+  auto cell_of = [&](size_t i) { return packed ? entries[i] >> 16 : cells[i].first; };
+  auto triangle_of = [&](size_t i) { return packed ? static_cast<uint32_t>(entries[i] & 0xFFFF) : cells[i].second; };
   std::vector<std::pair<uint32_t, uint32_t>> out;
-  for (size_t begin = 0; begin < cells.size();) {
+  for (size_t begin = 0; begin < count;) {
+    const uint64_t cell = cell_of(begin);
     size_t end = begin;
-    while (end < cells.size() && cells[end].first == cells[begin].first) ++end;
+    while (end < count && cell_of(end) == cell) ++end;
     for (size_t i = begin; i < end; ++i)
       for (size_t j = i + 1; j < end; ++j) {
-        const uint32_t s = cells[i].second, t = cells[j].second;
+        const uint32_t s = triangle_of(i), t = triangle_of(j);
         // Boxes overlap, and this cell holds the low corner of the overlap: each pair once.
         const Eigen::Vector3i l = lo[s].cwiseMax(lo[t]), h = hi[s].cwiseMin(hi[t]);
-        if ((l.array() > h.array()).any() || key(l.x(), l.y(), l.z()) != cells[begin].first) continue;
+        if ((l.array() > h.array()).any() || (packed ? key16(l.x(), l.y(), l.z()) : key(l.x(), l.y(), l.z())) != cell)
+          continue;
         if ((box_lo[s].array() > box_hi[t].array()).any() || (box_lo[t].array() > box_hi[s].array()).any()) continue;
         const Tri& a = mesh.triangles[s];
         const Tri& b = mesh.triangles[t];

@@ -43,4 +43,8 @@ using MeasurementSet = std::bitset<13>;
 // the maker measures a candidate body dozens of times for the few keys a request names.
 Measurements measure_body(const Slicer& mesh, const Landmarks& landmarks, MeasurementSet which);
 
+// analyse_body on one index of the body's mesh for both the landmark search and the measurements;
+// `topology` (may be null) must be the mesh's triangles' (the maker's bodies share MakeHuman's).
+void analyse_body(Body& body, const std::string& source, const SliceTopology* topology);
+
 }  // namespace drape::body

@@ -159,13 +159,7 @@ Body body::mh_body(const MhShape& shape, BodySkeleton skeleton) {
   untangle(b.mesh);  // the toes touch: part them
   const Eigen::Affine3f placed = normalise_body_placement(b.mesh, "made body");
   b.mesh.normals = vertex_normals(b.mesh.positions, b.mesh.triangles);
-  {
-    // analyse_body, on an index that knows the model's triangles
-    const body::Slicer indexed(b.mesh, &model.topology);
-    b.landmarks = body::find_landmarks(indexed, "made body");
-    b.measurements = body::measure_body(indexed, b.landmarks, body::MeasurementSet().set());
-    b.parts = segment_body(b.mesh, b.landmarks);
-  }
+  body::analyse_body(b, "made body", &model.topology);
   // The skeleton follows the shape: each joint is the mean of its vertex group on this body.
   const body::MhSkeleton& rig = model.skeleton(skeleton == BodySkeleton::CmuMb ? "cmu_mb" : "default");
   for (const auto& j : rig.joints) {

@@ -8,6 +8,7 @@
 #include <queue>
 
 #include "drape/body.hpp"
+#include "body/analysis.hpp"
 
 namespace drape {
 
@@ -76,9 +77,12 @@ std::vector<BodyPart> segment_body(const Mesh& mesh, const Landmarks& lm) {
   return parts;
 }
 
-void analyse_body(Body& body, const std::string& source) {
-  body.landmarks = find_landmarks(body.mesh, source);
-  body.measurements = measure_body(body.mesh, body.landmarks);
+void analyse_body(Body& body, const std::string& source) { body::analyse_body(body, source, nullptr); }
+
+void body::analyse_body(Body& body, const std::string& source, const SliceTopology* topology) {
+  const Slicer indexed(body.mesh, topology);  // indexed once for the search and the measurements
+  body.landmarks = find_landmarks(indexed, source);
+  body.measurements = measure_body(indexed, body.landmarks, MeasurementSet().set());
   body.parts = segment_body(body.mesh, body.landmarks);
 }
 

@@ -11,7 +11,12 @@
 namespace drape::body {
 
 namespace {
-bool piece_before(const SectionPiece& a, const SectionPiece& b);
+
+// Pieces of a section in a stable order: by u of the centroid, then v.
+bool piece_before(const SectionPiece& a, const SectionPiece& b) {
+  return a.centroid.x() < b.centroid.x() || (a.centroid.x() == b.centroid.x() && a.centroid.y() < b.centroid.y());
+}
+
 }  // namespace
 
 SlicePlane horizontal_plane(float height) {
@@ -225,15 +230,6 @@ std::vector<SectionPiece> slice(const Slicer& mesh, const SlicePlane& plane) {
   std::sort(pieces.begin(), pieces.end(), piece_before);
   return pieces;
 }
-
-namespace {
-
-// Pieces of a horizontal section in slice's order: by u of the centroid, then v.
-bool piece_before(const SectionPiece& a, const SectionPiece& b) {
-  return a.centroid.x() < b.centroid.x() || (a.centroid.x() == b.centroid.x() && a.centroid.y() < b.centroid.y());
-}
-
-}  // namespace
 
 namespace {
 

@@ -26,7 +26,7 @@ void BM_MakeBodyFromMeasurements(benchmark::State& state) {
   drape::body::makehuman_model();  // the pack is decoded once per process, not per body
   for (auto _ : state) benchmark::DoNotOptimize(drape::make_human_body(r.sex, request));
 }
-BENCHMARK(BM_MakeBodyFromMeasurements)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MakeBodyFromMeasurements)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Every key at once (a woman of 1.70 m).
 void BM_MakeBodyAllKeys(benchmark::State& state) {
@@ -36,7 +36,7 @@ void BM_MakeBodyAllKeys(benchmark::State& state) {
   drape::body::makehuman_model();
   for (auto _ : state) benchmark::DoNotOptimize(drape::make_human_body(drape::Sex::Female, request));
 }
-BENCHMARK(BM_MakeBodyAllKeys)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MakeBodyAllKeys)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // MakeHuman's body at given macros, untangled, analysed and rigged: the last step of every make.
 void BM_MakeHumanBodyOfAShape(benchmark::State& state) {

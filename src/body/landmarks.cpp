@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <optional>
+#include <vector>
 
 #include "body/analysis.hpp"
 #include "body/slicing.hpp"
@@ -145,6 +146,28 @@ bool find_underbust(const Slicer& mesh, Landmarks& lm, float height) {
   return true;
 }
 
+namespace {
+
+// The torso's outline at each level from `from` up to (not including) `to`, 3 mm apart: its hull
+// girth and the extent of its depth. The levels are independent: on every core, in level order.
+struct Level {
+  float y, girth, front, back;
+  bool found;
+};
+std::vector<Level> torso_levels(const Slicer& mesh, float from, float to) {
+  std::vector<Level> levels;
+  for (float y = from; y < to; y += 0.003f) levels.push_back({y, 0.0f, 0.0f, 0.0f, false});
+#pragma omp parallel for schedule(dynamic, 4)
+  for (size_t i = 0; i < levels.size(); ++i) {
+    auto s = straddling_outline(mesh, levels[i].y);
+    if (!s) continue;
+    levels[i] = {levels[i].y, hull_perimeter(std::move(s->points)), s->max.y(), s->min.y(), true};
+  }
+  return levels;
+}
+
+}  // namespace
+
 WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm) {
   const float crotch_y = lm.crotch.y();
   const float low_armpit = std::min(lm.left_armpit.y(), lm.right_armpit.y());
@@ -152,30 +175,21 @@ WaistAndHip find_waist_and_hip(const Slicer& mesh, Landmarks& lm) {
   // the bust and underbust landmarks, which a man's chest or a belly can move).
   {
     float best = 1e9f;
-    const float from = crotch_y + 0.3f * (low_armpit - crotch_y);
-    for (float y = from; y < crotch_y + 0.7f * (low_armpit - crotch_y); y += 0.003f) {
-      auto s = straddling_outline(mesh, y);
-      if (!s) continue;
-      const float g = hull_perimeter(std::move(s->points));
-      if (g < best) {
-        best = g;
-        lm.waist = Vec3f(0.0f, y, s->max.y());
+    for (const Level& l : torso_levels(mesh, crotch_y + 0.3f * (low_armpit - crotch_y), crotch_y + 0.7f * (low_armpit - crotch_y)))
+      if (l.found && l.girth < best) {
+        best = l.girth;
+        lm.waist = Vec3f(0.0f, l.y, l.front);
       }
-    }
     if (best > 1e8f) return WaistAndHip::kNoWaist;
   }
   // Hip: the fullest torso section between the crotch and the waist.
   {
     float best = 0;
-    for (float y = crotch_y + 0.015f; y < lm.waist.y(); y += 0.003f) {
-      auto s = straddling_outline(mesh, y);
-      if (!s) continue;
-      const float g = hull_perimeter(std::move(s->points));
-      if (g > best) {
-        best = g;
-        lm.hip = Vec3f(0.0f, y, s->min.y());
+    for (const Level& l : torso_levels(mesh, crotch_y + 0.015f, lm.waist.y()))
+      if (l.found && l.girth > best) {
+        best = l.girth;
+        lm.hip = Vec3f(0.0f, l.y, l.back);
       }
-    }
     if (best <= 0) return WaistAndHip::kNoHips;
   }
 

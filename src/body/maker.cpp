@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <optional>
 #include <string_view>
 
@@ -271,8 +272,8 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
     // a narrower level elsewhere, and a flat chest's underbust flips between its two rules. An
     // underbust that is not requested is not searched for: only whether there is one matters.
     // Only the requested keys are measured.
-    auto pinned = [&](const Eigen::VectorXd& v) {
-      const Mesh& m = shaper(shape_at(v));
+    auto pinned_on = [&](Shaper& own_shaper, const Eigen::VectorXd& v) {
+      const Mesh& m = own_shaper(shape_at(v));
       Landmarks at = place(pins, m);
       Landmarks searched = at;
       const body::Slicer slicer(m, &topology);
@@ -282,15 +283,30 @@ body::MhShape body::solve_human_shape(Sex sex, const MeasurementRequest& given) 
         at = searched;
       return residuals(body::measure_body(slicer, at, measured), keys);
     };
+    auto pinned = [&](const Eigen::VectorXd& v) { return pinned_on(shaper, v); };
+    // The columns are independent measurements of shapes one step apart: on every core, each
+    // thread shaping into its own mesh; each column is computed the same way on any thread count.
     auto fresh_jacobian = [&]() {
       jac.resize(k, n);
-      for (Eigen::Index i = 0; i < n; ++i) {
-        const Unknown& u = unknowns[static_cast<size_t>(i)];
-        Eigen::VectorXd y = x;
-        const double h = x[i] + u.step <= u.hi ? u.step : -u.step;
-        y[i] += h;
-        jac.col(i) = (pinned(y) - r) / h;
+      std::vector<std::exception_ptr> failed(static_cast<size_t>(n));  // none may leave a parallel region
+#pragma omp parallel
+      {
+        Shaper own_shaper(model);
+#pragma omp for schedule(dynamic, 1)
+        for (Eigen::Index i = 0; i < n; ++i) {
+          try {
+            const Unknown& u = unknowns[static_cast<size_t>(i)];
+            Eigen::VectorXd y = x;
+            const double h = x[i] + u.step <= u.hi ? u.step : -u.step;
+            y[i] += h;
+            jac.col(i) = (pinned_on(own_shaper, y) - r) / h;
+          } catch (...) {
+            failed[static_cast<size_t>(i)] = std::current_exception();
+          }
+        }
       }
+      for (const auto& e : failed)
+        if (e) std::rethrow_exception(e);
     };
     if (jac.size() == 0) fresh_jacobian();
     double f = objective(r, x);

@@ -5,6 +5,7 @@
 // leg/torso boundary), split by side. The head is everything above the narrowest neck section.
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <queue>
 
 #include "drape/body.hpp"
@@ -82,8 +83,25 @@ void analyse_body(Body& body, const std::string& source) { body::analyse_body(bo
 void body::analyse_body(Body& body, const std::string& source, const SliceTopology* topology) {
   const Slicer indexed(body.mesh, topology);  // indexed once for the search and the measurements
   body.landmarks = find_landmarks(indexed, source);
-  body.measurements = measure_body(indexed, body.landmarks, MeasurementSet().set());
-  body.parts = segment_body(body.mesh, body.landmarks);
+  // The tape and the segmentation read the same landmarks and write apart: one on each core.
+  std::exception_ptr failed[2];  // none may leave a parallel region
+#pragma omp parallel sections num_threads(2)
+  {
+#pragma omp section
+    try {
+      body.measurements = measure_body(indexed, body.landmarks, MeasurementSet().set());
+    } catch (...) {
+      failed[0] = std::current_exception();
+    }
+#pragma omp section
+    try {
+      body.parts = segment_body(body.mesh, body.landmarks);
+    } catch (...) {
+      failed[1] = std::current_exception();
+    }
+  }
+  for (const auto& e : failed)
+    if (e) std::rethrow_exception(e);
 }
 
 }  // namespace drape

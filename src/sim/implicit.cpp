@@ -13,6 +13,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wnull-dereference"
 #include <Eigen/CholmodSupport>
+#include <omp.h>
 #include <Eigen/Sparse>
 #pragma GCC diagnostic pop
 #include <algorithm>
@@ -77,6 +78,23 @@ std::mutex& blas_lock() {
   static std::mutex lock;
   return lock;
 }
+
+// Debian's CHOLMOD is built with OpenMP regions of a fixed four threads (CHOLMOD_OMP_NUM_THREADS)
+// inside the supernodal factorisation, one per large supernode: on two cores, their threads'
+// wake-ups and sleeps cost more than the factorisation's arithmetic (the shirt's 4188 unknowns: 38
+// ms a factorisation, a third of it in the kernel's futex calls). No setting of CHOLMOD's reaches
+// them, so while it runs (under the BLAS lock, one thread at a time) no OpenMP region may be
+// active: the process's other loops run on one thread meanwhile, which changes none of their results.
+class SerialOpenMp {
+ public:
+  SerialOpenMp() : levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~SerialOpenMp() { omp_set_max_active_levels(levels_); }
+  SerialOpenMp(const SerialOpenMp&) = delete;
+  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+ private:
+  int levels_;
+};
 
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -194,6 +212,7 @@ struct ImplicitSolver::Impl {
   // out = A^-1 rhs with the current factorisation (under the BLAS lock).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
     const std::lock_guard<std::mutex> hold(blas_lock());
+    const SerialOpenMp serial;
     out = cholesky.solve(rhs);
   }
 
@@ -329,7 +348,11 @@ void ImplicitSolver::Impl::analyse_pattern() {
       block_offset[3 * b + static_cast<size_t>(k)] = static_cast<int>(found - inner);
     }
   }
-  cholesky.analyzePattern(matrix);
+  {
+    const std::lock_guard<std::mutex> hold(blas_lock());
+    const SerialOpenMp serial;
+    cholesky.analyzePattern(matrix);
+  }
 }
 
 void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h,
@@ -661,6 +684,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     if (!solved) {
       {
         const std::lock_guard<std::mutex> hold(blas_lock());
+        const SerialOpenMp serial;
         w.cholesky.factorize(w.matrix);
       }
       timer.mark(profile ? profile->factorize : scratch_time);

@@ -60,6 +60,7 @@ struct ImplicitStepStats {
 struct ImplicitProfile {
   double contacts = 0, assemble = 0, factorize = 0, solve = 0, line_search = 0;
   uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
+  uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration, one after a factorisation
   double total_seconds() const { return contacts + assemble + factorize + solve + line_search; }
 };
 

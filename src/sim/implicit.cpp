@@ -209,11 +209,13 @@ struct ImplicitSolver::Impl {
   bool planes_valid = false;  // contact planes found at least once  // the factorisation holds a matrix of this step
   Eigen::VectorXd residual_vec, search, product, preconditioned;  // conjugate gradients
   bool preconditioned_solve();
+  uint64_t triangular_solves = 0;  // since construction
   // out = A^-1 rhs with the current factorisation (under the BLAS lock).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
     const std::lock_guard<std::mutex> hold(blas_lock());
     const SerialOpenMp serial;
     out = cholesky.solve(rhs);
+    ++triangular_solves;
   }
 
   Impl(const ClothModel& m, size_t colliders);
@@ -638,6 +640,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   const double h = s.time_step;
   Timer timer(profile != nullptr);
   double scratch_time = 0;
+  const uint64_t solves_before = w.triangular_solves;
   for (Collider* c : colliders) c->update(state.time + h);
   // Start: x0 = x_n; the inertial target y = x_n + h v_n (at rest: x_n); pinned particles follow y.
   for (size_t i = 0; i < w.n; ++i) {
@@ -766,6 +769,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   if (profile) {
     ++profile->steps;
     profile->newton_iterations += static_cast<uint64_t>(st.newton_iterations);
+    profile->triangular_solves += w.triangular_solves - solves_before;
   }
   return state.status;
 }

@@ -667,6 +667,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   // around the current iterate x_k (no force at x_k, so the fixed point is the state of rest), with
   // h_d growing while full Newton steps are taken and shrinking when the line search halves.
   double hd = h;
+  bool cg_missed = false;
   for (int it = 0; it < kMaxNewtonIterations; ++it) {
     if (it > 0) w.detect_contacts(colliders, s, h, false);
     if (s.quasi_static)
@@ -681,8 +682,12 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     }
     // The Newton direction: conjugate gradients preconditioned by the last factorisation (the
     // matrix changes little from one iteration to the next), or a fresh factorisation when there is
-    // none yet in this step or they do not reach the tolerance in kMaxPcgIterations.
-    const bool solved = w.factored && w.preconditioned_solve();
+    // none yet in this step or they do not reach the tolerance in kMaxPcgIterations. Once they
+    // missed in a step, the step factorises directly: a factorisation costs about 14 of their
+    // iterations, and where contacts or the strain barrier changed the matrix enough for one miss,
+    // the next attempt mostly misses too (a walk's steps: every attempt).
+    const bool solved = w.factored && !cg_missed && w.preconditioned_solve();
+    cg_missed = cg_missed || (w.factored && !solved);
     timer.mark(profile ? profile->solve : scratch_time);
     if (!solved) {
       {

@@ -41,6 +41,10 @@ struct BodyColliderOptions {
   // sdf: grid spacing (metres) and the half width of the narrow band that is stored exactly.
   float voxel_size = 0.004f;
   float band = 0.02f;
+  // bvh: index the space near the body (a candidate list per 1 cm cell) for fast queries. It takes
+  // about 0.2 s on a 27k-triangle body and pays off over a simulation; a few thousand queries
+  // (measuring a dressed garment) are cheaper straight from the tree.
+  bool candidate_grid = true;
 };
 
 // Body vertex positions at time t, written into `positions` (already sized to the vertex count).

@@ -37,7 +37,7 @@ std::unique_ptr<BodyCollider> make_body_collider(const Mesh& body, CollisionMeth
     throw std::invalid_argument("body collider: the body mesh has no triangles");
   switch (method) {
     case CollisionMethod::image: return std::make_unique<collision::ImageCollider>(body, options);
-    case CollisionMethod::bvh: return std::make_unique<collision::BvhCollider>(body);
+    case CollisionMethod::bvh: return std::make_unique<collision::BvhCollider>(body, options.candidate_grid);
     case CollisionMethod::sdf: return std::make_unique<collision::SdfCollider>(body, options.voxel_size, options.band);
   }
   throw std::invalid_argument("body collider: unknown method");

@@ -33,13 +33,13 @@ bool exact_sample(const TriangleBvh& bvh, const Vec3f& p, float radius, ContactS
   return found;
 }
 
-BvhCollider::BvhCollider(const Mesh& body) : surface_(body.positions, body.triangles) {
+BvhCollider::BvhCollider(const Mesh& body, bool candidate_grid) : surface_(body.positions, body.triangles) {
   const auto start = std::chrono::steady_clock::now();
   bvh_ = std::make_unique<TriangleBvh>(surface_, /*refit=*/true);
-  bvh_->build_candidate_grid();
+  if (candidate_grid) bvh_->build_candidate_grid();
   stats_.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // Embree reports no size: about 64 B per triangle.
-  stats_.memory_bytes = surface_.triangle_count() * 64 + bvh_->candidate_grid()->memory_bytes();
+  stats_.memory_bytes = surface_.triangle_count() * 64 + (candidate_grid ? bvh_->candidate_grid()->memory_bytes() : 0);
 }
 
 void BvhCollider::set_surface(std::span<const Vec3f> positions, double t) {

@@ -18,7 +18,7 @@ void sample_from_hit(const BodySurface& surface, const SurfaceHit* hit, const Ve
 
 class BvhCollider final : public BodyCollider {
  public:
-  explicit BvhCollider(const Mesh& body);
+  explicit BvhCollider(const Mesh& body, bool candidate_grid = true);
   std::string_view name() const override { return "bvh"; }
   void set_surface(std::span<const Vec3f> positions, double t) override;
   void query(std::span<const Vec3f> points, float radius, std::span<ContactSample> out) const override;

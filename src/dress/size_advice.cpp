@@ -150,7 +150,9 @@ FitAnalysis analyse_dress_fit(const Body& body, const DressResult& result, std::
   std::vector<FitGarment> in;
   for (size_t i = 0; i < result.garments.size() && i < garments.size(); ++i)
     in.push_back(fit_garment(result.garments[i], garments[i]));
-  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  BodyColliderOptions exact;
+  exact.candidate_grid = false;  // a few thousand distances: straight from the tree
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh, exact);
   return analyse_fit(body, in, *collider);
 }
 
@@ -177,7 +179,9 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   const bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
   if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
 
-  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  BodyColliderOptions exact;
+  exact.candidate_grid = false;  // a few thousand distances per size: straight from the tree
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh, exact);
   // Before draping: each size's pattern placed round the body and measured at its girth lines.
   {
     const auto placement_collider = make_body_collider(body.mesh, options.collision);

@@ -368,8 +368,7 @@ TEST(DressScene, ShirtLOnHeavyFemaleBody) {
 }
 
 // The jeans' L (drafted for 1.03 m hips) on the heavy female body (hips 1.03 m): every gate. Her
-// size by the chart is M (nearest over waist and hips), which passes too since session 13 (before,
-// both outseams stayed 8 mm open at her hips; SharedBodyOwnSize).
+// size by the chart is M (nearest over waist and hips), which passes too (SharedBodyOwnSize).
 TEST(DressScene, JeansLOnHeavyFemaleBody) {
   if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
   const auto path = DRAPE_REQUIRE_SHARED("bodies/makehuman/derived/mh_female_heavy.obj");

@@ -298,7 +298,7 @@ INSTANTIATE_TEST_SUITE_P(GarmentCode, ImportedPattern,
 //     corners were pulled 45-58 mm open). The same at 22:30 UTC (main 9b044f3 with the band's
 //     softer seam-crossing springs: 10.42 %, 0.135 m, report.json final_max_speed 37 m/s): the
 //     fastest vertices are where the band's side seams meet the panel seams, a vertex joined to
-//     two partners at one point; a mass floor on the band's vertices did not settle it. Session 13
+//     two partners at one point; a mass floor on the band's vertices did not settle it. Later
 //     (the drop measured from the placement, the last stitches pulled closed): settled, stayed on
 //     (0.044 m), every seam closed (0.13 mm), but the skirt's top edge 11.86 % stretched at her
 //     upper hips (the converge passes at their cap; 10.34 % with a cap of 512 in a trial build);

@@ -195,9 +195,14 @@ void FitDoesNotDependOnTheThreadCount(const SizeAdvice* advice) {
   EXPECT_EQ(one.garments[0].strain_percent, two.garments[0].strain_percent);
 }
 
+// The jeans as drafted without their waistband, with the explicit solver on the generator's body:
+// there the sizes under her hips do not close, which is what the fit judgments below are about
+// (with the waistband, the default solver closes every size on her).
 TEST(JeansAdvice, OnTheGeneratorsFemaleBody) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing five sizes is too slow";
-  const SizeAdvice advice = advise_size(test::generator_body(Sex::Female), *builtin_garment("jeans"), explicit_solver());
+  GarmentSpec jeans = *builtin_garment("jeans");
+  jeans.bands.clear();
+  const SizeAdvice advice = advise_size(test::generator_body(Sex::Female), jeans, explicit_solver());
   {
     SCOPED_TRACE("RecommendsTheChartsSizeAndNeverOneThatDoesNotClose");
     RecommendsTheChartsSizeAndNeverOneThatDoesNotClose(&advice);
@@ -283,11 +288,9 @@ std::string advice_case_name(const ::testing::TestParamInfo<AdviceCase>& p) {
 struct ChartSizeDoesNotFit {
   const char *garment, *body, *because;  // because: "slides off" or "does not close"
 };
-// The jeans M (the chart's M: waist 0.74 m, hips 0.99 m; no waistband) fall 0.18 m down the
-// average MakeHuman man's narrower hips (0.94 m, waist 0.75 m); he is recommended the S.
-constexpr ChartSizeDoesNotFit kChartSizeDoesNotFit[] = {
-    {"jeans", "makehuman/derived/mh_male_average.obj", "slides off"},
-};
+// None at present. (Before the jeans had a waistband, their M fell 0.18 m down the average
+// MakeHuman man's hips, 0.94 m against the chart's 0.99 m, and he was recommended the S.)
+const std::vector<ChartSizeDoesNotFit> kChartSizeDoesNotFit{};
 
 class ChartSizeIsRecommended : public ::testing::TestWithParam<AdviceCase> {};
 TEST_P(ChartSizeIsRecommended, UnlessItDoesNotCloseOrStayOn) {

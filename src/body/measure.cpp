@@ -3,7 +3,6 @@
 // straddles the midline, so arms never count. Limb girths use sections perpendicular to the limb.
 #include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "body/analysis.hpp"
 #include "drape/body.hpp"
@@ -86,13 +85,8 @@ Measurements body::measure_body(const Slicer& mesh, const Landmarks& lm, Measure
     // Bust (women) or chest (men) girth: the fullest torso section from the bust points up to 2 cm
     // under the armpits, so it reads the bust of a woman and the chest under the arms of a man.
     const float chest_top = std::min(lm.left_armpit.y(), lm.right_armpit.y()) - 0.02f;
-    std::vector<float> levels{bust_y};
-    for (float y = bust_y + 0.003f; y <= chest_top; y += 0.003f) levels.push_back(y);
-    // The sections are independent and the largest is the same whatever the order: on every core.
-    float bust = 0.0f;
-#pragma omp parallel for reduction(max : bust) schedule(dynamic, 2)
-    for (size_t i = 0; i < levels.size(); ++i) bust = std::max(bust, torso_girth_at(mesh, levels[i]));
-    m.bust = bust;
+    m.bust = torso_girth_at(mesh, bust_y);
+    for (float y = bust_y + 0.003f; y <= chest_top; y += 0.003f) m.bust = std::max(m.bust, torso_girth_at(mesh, y));
   }
   if (which[kUnderbust]) m.underbust = torso_girth_at(mesh, lm.underbust.y());
   if (which[kWaist]) m.waist = torso_girth_at(mesh, lm.waist.y());

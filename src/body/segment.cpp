@@ -85,7 +85,7 @@ void body::analyse_body(Body& body, const std::string& source, const SliceTopolo
   body.landmarks = find_landmarks(indexed, source);
   // The tape and the segmentation read the same landmarks and write apart: one on each core.
   std::exception_ptr failed[2];  // none may leave a parallel region
-#pragma omp parallel sections num_threads(2)
+#pragma omp parallel sections
   {
 #pragma omp section
     try {

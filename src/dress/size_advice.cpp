@@ -115,6 +115,14 @@ std::string ease_summary(const SizeTrial& t) {
   return others.empty() ? s : s + "; " + join(others);
 }
 
+// The body's distances for measuring a dressed garment: a few thousand queries per size, cheaper
+// straight from the tree than through the candidate grid a simulation builds.
+std::unique_ptr<BodyCollider> exact_collider(const Body& body) {
+  BodyColliderOptions exact;
+  exact.candidate_grid = false;
+  return make_body_collider(body.mesh, CollisionMethod::bvh, exact);
+}
+
 }  // namespace
 
 FitGarment fit_garment(const DressedGarment& dressed, const Garment& garment) {
@@ -150,9 +158,7 @@ FitAnalysis analyse_dress_fit(const Body& body, const DressResult& result, std::
   std::vector<FitGarment> in;
   for (size_t i = 0; i < result.garments.size() && i < garments.size(); ++i)
     in.push_back(fit_garment(result.garments[i], garments[i]));
-  BodyColliderOptions exact;
-  exact.candidate_grid = false;  // a few thousand distances: straight from the tree
-  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh, exact);
+  const auto collider = exact_collider(body);
   return analyse_fit(body, in, *collider);
 }
 
@@ -179,9 +185,7 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   const bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
   if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
 
-  BodyColliderOptions exact;
-  exact.candidate_grid = false;  // a few thousand distances per size: straight from the tree
-  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh, exact);
+  const auto collider = exact_collider(body);
   // Before draping: each size's pattern placed round the body and measured at its girth lines.
   {
     const auto placement_collider = make_body_collider(body.mesh, options.collision);

@@ -85,14 +85,16 @@ std::mutex& blas_lock() {
 // ms a factorisation, a third of it in the kernel's futex calls). No setting of CHOLMOD's reaches
 // them, so while it runs (under the BLAS lock, one thread at a time) no OpenMP region may be
 // active: the process's other loops run on one thread meanwhile, which changes none of their results.
-class SerialOpenMp {
+// Every call into CHOLMOD holds one of these: the BLAS lock, then OpenMP made serial.
+class CholmodCall {
  public:
-  SerialOpenMp() : levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
-  ~SerialOpenMp() { omp_set_max_active_levels(levels_); }
-  SerialOpenMp(const SerialOpenMp&) = delete;
-  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+  CholmodCall() : hold_(blas_lock()), levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
+  ~CholmodCall() { omp_set_max_active_levels(levels_); }
+  CholmodCall(const CholmodCall&) = delete;
+  CholmodCall& operator=(const CholmodCall&) = delete;
 
  private:
+  std::lock_guard<std::mutex> hold_;
   int levels_;
 };
 
@@ -212,8 +214,7 @@ struct ImplicitSolver::Impl {
   uint64_t triangular_solves = 0;  // since construction
   // out = A^-1 rhs with the current factorisation (under the BLAS lock).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
-    const std::lock_guard<std::mutex> hold(blas_lock());
-    const SerialOpenMp serial;
+    const CholmodCall call;
     out = cholesky.solve(rhs);
     ++triangular_solves;
   }
@@ -351,8 +352,7 @@ void ImplicitSolver::Impl::analyse_pattern() {
     }
   }
   {
-    const std::lock_guard<std::mutex> hold(blas_lock());
-    const SerialOpenMp serial;
+    const CholmodCall call;
     cholesky.analyzePattern(matrix);
   }
 }
@@ -691,8 +691,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     timer.mark(profile ? profile->solve : scratch_time);
     if (!solved) {
       {
-        const std::lock_guard<std::mutex> hold(blas_lock());
-        const SerialOpenMp serial;
+        const CholmodCall call;
         w.cholesky.factorize(w.matrix);
       }
       timer.mark(profile ? profile->factorize : scratch_time);

@@ -52,7 +52,16 @@ void run_fit(const FitArgs& a) {
     for (const RegionFit& r : t.pattern)
       if (r.girth) pattern += fmt::format("{}{} {:+.1f} cm ({})", pattern.empty() ? "" : ", ", r.region, 100 * r.ease_m, to_string(r.verdict));
     if (!pattern.empty()) std::fprintf(stderr, "     on the pattern, before draping: %s\n", pattern.c_str());
+    if (advice.chart_from_pattern) {
+      std::string cut_for;
+      for (const PatternGirth& g : t.pattern_girths)
+        cut_for += fmt::format("{}{} {:.2f} m ({:.2f} m at {}, less {:.0f} cm ease)", cut_for.empty() ? "" : ", ", g.key,
+                               g.body_m(), g.girth_m, g.line, 100 * g.ease_m);
+      if (!cut_for.empty()) std::fprintf(stderr, "     cut for a body with %s\n", cut_for.c_str());
+    }
   }
+  if (advice.chart_from_pattern)
+    std::fprintf(stderr, "%s has no size chart: its pattern made one (girths at its own lines less its ease)\n", spec.name.c_str());
   if (advice.has_recommendation()) std::fprintf(stderr, "\n%s", fit_table(advice.sizes[advice.recommended].fit).c_str());
   std::fprintf(stderr, "\n");
   for (const std::string& line : advice.reasons) std::fprintf(stderr, "%s\n", line.c_str());

@@ -1,7 +1,8 @@
 // `drape garments`: the built-in garments. `drape garment check FILE`: validate a garment file (drape
 // JSON, GarmentCode, 2021 template or DXF) in every size and print what it holds. `drape garment
 // mesh FILE -o panels.obj|.glb`: the flat meshed panels, laid out side by side, with the seam
-// vertex pairs (OBJ: one `l` element per pair between the panels' vertices).
+// vertex pairs (OBJ: one `l` element per pair between the panels' vertices). `drape garment chart
+// FILE`: the body each size is cut for, measured on its pattern.
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
@@ -13,6 +14,7 @@
 #include "drape/files.hpp"
 #include "drape/garment.hpp"
 #include "drape/io.hpp"
+#include "drape/size_advice.hpp"
 
 namespace drape::app {
 namespace {
@@ -71,6 +73,29 @@ void run_check(const std::string& file, const std::string& size) {
                s.ease > 0 ? fmt::format(", ease {:.1f} %", 100 * s.ease) : "");
   if (g.seams.empty() && g.panels.size() > 1)
     fmt::print("  note: no seams (DXF pieces only); name them in a companion garment file to sew the pieces\n");
+}
+
+// Each size's girths at the garment's own lines and the body they are cut for (the chart a
+// pattern without one gets), beside the file's chart where it has one.
+void run_chart(const std::string& file, const std::string& body_name) {
+  const GarmentSpec spec = load_garment(file);
+  const Body body = load_command_body(body_name, "", LoadOptions{});
+  const std::vector<PatternSize> sizes = measure_pattern(body, spec, DressOptions{});
+  const std::vector<SizeMeasurements> made = chart_from_pattern(sizes);
+  fmt::print("{}: the body each size is cut for, from its girths at its own lines less its intended ease\n", spec.name);
+  fmt::print("(measured on the panels placed round the {} body, before sewing)\n", body_name);
+  for (size_t k = 0; k < sizes.size(); ++k) {
+    fmt::print("  {}:\n", sizes[k].size);
+    if (sizes[k].girths.empty()) fmt::print("    no girth found (a top needs side seams, a bottom a top edge)\n");
+    for (const PatternGirth& g : sizes[k].girths) {
+      std::string file_chart;
+      if (k < spec.size_chart.size())
+        if (const auto it = spec.size_chart[k].find(g.key); it != spec.size_chart[k].end())
+          file_chart = fmt::format("; the garment's chart: {:.3f} m", it->second);
+      fmt::print("    {:<6} {:.3f} m: garment {:.3f} m at {}, less {:.0f} cm ease{}\n", g.key, made[k].at(g.key), g.girth_m,
+                 g.line, 100 * g.ease_m, file_chart);
+    }
+  }
 }
 
 struct MeshArgs {
@@ -153,6 +178,14 @@ void add_garment_command(CLI::App& app) {
   check->add_option("FILE", *check_file, "Garment file or built-in garment name")->required();
   check->add_option("--size", *check_size, "Size to summarise (default: the base size)");
   check->callback([check_file, check_size] { run_check(*check_file, *check_size); });
+
+  auto chart_file = std::make_shared<std::string>();
+  auto chart_body = std::make_shared<std::string>("female");
+  CLI::App* chart = garment->add_subcommand(
+      "chart", "The body each size is cut for, measured on the pattern (the size chart a garment without one gets)");
+  chart->add_option("FILE", *chart_file, "Garment file or built-in garment name")->required();
+  chart->add_option("--body", *chart_body, "Body the panels are placed round: female, male or a body file")->capture_default_str();
+  chart->callback([chart_file, chart_body] { run_chart(*chart_file, *chart_body); });
 
   auto args = std::make_shared<MeshArgs>();
   CLI::App* mesh = garment->add_subcommand("mesh", "Mesh a garment's panels flat and write them with their seams");

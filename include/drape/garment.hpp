@@ -134,6 +134,10 @@ struct GarmentSpec {
   std::vector<PanelSpec> panels;
   std::vector<SeamSpec> seams;
   std::vector<ElasticBand> bands;
+  // The wearing ease the pattern is drafted with at the bust, waist and hips (garment girth minus
+  // body girth, metres); keys the file leaves out take default_intended_ease() (size_advice.hpp).
+  // A size chart is made from it for a pattern that has none (chart_from_pattern).
+  SizeMeasurements intended_ease;
 };
 
 // Seam sides may differ in length by this much plus the seam's ease (see docs/garment-format.md).

@@ -182,18 +182,32 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
     if (k < spec.size_chart.size() && !spec.size_chart[k].empty()) t.chart_distance = chart_distance(spec.size_chart[k], body.measurements);
     advice.sizes.push_back(std::move(t));
   }
-  const bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
-  if (has_chart) advice.chart_size = choose_size(spec, body.measurements).size;
-
-  const auto collider = exact_collider(body);
-  // Before draping: each size's pattern placed round the body and measured at its girth lines.
+  // Before draping: each size's pattern placed round the body and measured at the body's girth
+  // lines and at its own.
   {
     const auto placement_collider = make_body_collider(body.mesh, options.collision);
     for (SizeTrial& t : advice.sizes) {
       const DressedGarment placed = prepare_garment(body, t.garment, *placement_collider, options);
       t.pattern = pattern_measurements(body, fit_garment(placed, t.garment));
+      t.pattern_girths = pattern_girths(body, placed, t.garment, spec);
     }
   }
+  bool has_chart = std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
+  GarmentSpec charted;
+  if (!has_chart) {
+    // No chart in the file: the one its pattern makes.
+    std::vector<PatternSize> measured;
+    for (const SizeTrial& t : advice.sizes) measured.push_back({t.size, t.pattern_girths});
+    charted = spec;
+    charted.size_chart = chart_from_pattern(measured);
+    for (size_t k = 0; k < advice.sizes.size(); ++k)
+      if (!charted.size_chart[k].empty()) advice.sizes[k].chart_distance = chart_distance(charted.size_chart[k], body.measurements);
+    has_chart = advice.chart_from_pattern =
+        std::any_of(advice.sizes.begin(), advice.sizes.end(), [](const SizeTrial& t) { return t.chart_distance >= 0; });
+  }
+  if (has_chart) advice.chart_size = choose_size(advice.chart_from_pattern ? charted : spec, body.measurements).size;
+
+  const auto collider = exact_collider(body);
   const auto count = static_cast<int>(advice.sizes.size());
   std::vector<std::exception_ptr> errors(advice.sizes.size());
   size_t done = 0;
@@ -248,9 +262,10 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
             (advice.sizes[best].chart_distance < 0 || advice.sizes[k].chart_distance < advice.sizes[best].chart_distance))
           best = k;
       advice.recommended = best;
+      const char* chart = advice.chart_from_pattern ? "the size chart made from the pattern" : "the size chart";
       advice.rule = advice.sizes[best].size == advice.chart_size
-                        ? fmt::format("the size chart's size for the body; it {}", group_words)
-                        : fmt::format("the size chart gives {}, which does not qualify; {} is the nearest in the chart that {}",
+                        ? fmt::format("{}'s size for the body; it {}", chart, group_words)
+                        : fmt::format("{} gives {}, which does not qualify; {} is the nearest in the chart that {}", chart,
                                       advice.chart_size, advice.sizes[best].size, group_words);
     } else {
       const auto loose_fit = std::find_if(group.begin(), group.end(), [&](size_t k) { return !tight(k); });
@@ -284,6 +299,8 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
   extra["recommended_size"] = advice.has_recommendation() ? nlohmann::ordered_json(advice.sizes[advice.recommended].size)
                                                           : nlohmann::ordered_json(nullptr);
   extra["chart_size"] = advice.chart_size.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(advice.chart_size);
+  extra["chart_source"] = advice.chart_size.empty() ? nlohmann::ordered_json(nullptr)
+                          : nlohmann::ordered_json(advice.chart_from_pattern ? "pattern" : "garment");
   extra["rule"] = advice.rule;
   extra["reasons"] = advice.reasons;
   nlohmann::ordered_json sizes = nlohmann::ordered_json::array();
@@ -307,6 +324,10 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
         pattern.push_back({{"region", r.region}, {"verdict", std::string(to_string(r.verdict))},
                            {"garment_length_m", r.garment_m}, {"body_length_m", r.body_m}, {"reason", r.reason}});
     }
+    nlohmann::ordered_json girths = nlohmann::ordered_json::array();
+    for (const PatternGirth& g : t.pattern_girths)
+      girths.push_back({{"key", g.key}, {"line", g.line}, {"garment_girth_m", g.girth_m}, {"intended_ease_m", g.ease_m},
+                        {"body_m", g.body_m()}});
     sizes.push_back({{"size", t.size},
                      {"recommended", k == advice.recommended},
                      {"verdict", t.verdict},
@@ -315,6 +336,7 @@ std::string size_advice_json(const Body& body, const SizeAdvice& advice) {
                      {"chart_distance", t.chart_distance >= 0 ? nlohmann::ordered_json(t.chart_distance) : nlohmann::ordered_json(nullptr)},
                      {"regions", regions},
                      {"pattern", pattern},
+                     {"pattern_girths", girths},
                      {"fit", fit},
                      {"gates", {{"passed", failed.empty()}, {"failed", failed}, {"checks", gates}}},
                      {"max_strain", t.result.quality.max_strain},

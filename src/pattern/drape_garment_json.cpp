@@ -327,6 +327,18 @@ GarmentSpec parse_drape_garment(const Json& root, const std::string& source, con
     }
   }
 
+  // The wearing ease the pattern is drafted with.
+  if (const Json* ease = optional_field(root, "intended_ease")) {
+    const Where we = top.at("intended_ease");
+    if (!ease->is_object()) we.fail("expected an object of measurement: metres (bust, waist, hips)");
+    for (const auto& [key, value] : ease->items()) {
+      if (key != "bust" && key != "waist" && key != "hips") we.at(key).fail("unknown girth (expected one of: bust, waist, hips)");
+      const double metres = as_number(value, we.at(key));
+      if (!(metres >= -0.2 && metres <= 0.5)) we.at(key).fail("expected metres, between -0.2 and 0.5");
+      spec.intended_ease[key] = metres;
+    }
+  }
+
   // Seams.
   if (const Json* seams = optional_field(root, "seams")) {
     if (!seams->is_array()) top.at("seams").fail("expected a list");

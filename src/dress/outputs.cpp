@@ -137,11 +137,28 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                                  {"max_depth_m", r.quality.skin_through.max_depth_m},
                                  {"tolerance_m", kSkinThroughTolerance}};
   extra["setup_seconds"] = r.setup_seconds;
+  if (r.soft_body) {
+    // The soft body (docs/soft-body.md): per region its volume change (a fraction of its tissue's
+    // volume, area x depth) and how deep it was pressed in.
+    nlohmann::ordered_json regions = nlohmann::ordered_json::array();
+    for (const SoftRegionState& g : r.soft_body->regions)
+      regions.push_back({{"name", g.name}, {"vertices", g.vertices}, {"volume_change", g.volume_change},
+                         {"compression_m", g.compression_m}, {"bulge_m", g.bulge_m}});
+    extra["soft_body"] = {{"regions", regions},
+                          {"rounds", r.soft_body->rounds},
+                          {"last_move_m", r.soft_body->last_move_m},
+                          {"tissue_depth_m", o.soft.depth},
+                          {"tissue_stiffness_pa_per_m", o.soft.tissue_stiffness},
+                          {"individual_share", o.soft.individual},
+                          {"seconds", r.soft_body->seconds}};
+  }
   return report_json(r.quality, r.simulation, r.gates, extra.dump());
 }
 
-void write_dress_outputs(const std::filesystem::path& dir, const Body& body, const DressResult& result,
+void write_dress_outputs(const std::filesystem::path& dir, const Body& given, const DressResult& result,
                          const DressOptions& options) {
+  // A soft body is drawn as the garments left it.
+  const Body& body = result.soft_body ? result.soft_body->body : given;
   // Everything is encoded first, then written, so a failure while encoding leaves nothing behind.
   const std::vector<unsigned char> glb = encode_glb(dressed_scene(body, result));
 
@@ -173,7 +190,7 @@ void write_dress_outputs(const std::filesystem::path& dir, const Body& body, con
   for (int y = 0; y < strain.height; ++y)
     std::copy_n(strain.pixel(0, y), 3 * static_cast<size_t>(std::min(strain.width, both.width)), both.pixel(0, shaded.height + y));
   const std::vector<uint8_t> png = encode_png(both);
-  const std::string report = dress_report_json(body, result, options);
+  const std::string report = dress_report_json(given, result, options);
 
   write_file_atomic(dir / "dressed.glb", glb);
   write_file_atomic(dir / "preview.png", png);

@@ -1,0 +1,92 @@
+#pragma once
+// A body that gives way under tight clothes: Vassilev's support springs (docs/soft-body.md,
+// ../shared/papers/vassilev-deformable-body-support-springs.txt).
+//
+// The body's soft regions (belly, buttocks, thighs, bust, upper arms) are found from its landmarks
+// and body parts; every other vertex (over bone: hip bones, shins, shoulders, collarbones, and the
+// rest of the body) stays put. Each soft vertex hangs on a support spring from a point of an inner
+// frame, `depth` straight in from it along its normal, and the surface is a membrane of springs
+// along its edges. A region's springs act together (eq. 5 and 6):
+//
+//   l_tot = sum_i c_i l_i,    f_i = -c_i K (dl_tot + C dl_i) u_i,
+//
+// c_i = the vertex's area over the mean vertex area, u_i the unit vector from the frame point to
+// the vertex, K the collective stiffness and C in (0, 1) the share of each spring's own response:
+// pressed in one place, a region bulges elsewhere and keeps its volume. Eq. 6 is the gradient of
+//
+//   E = K/2 (dl_tot^2 + C sum_i c_i dl_i^2),
+//
+// to which drape adds the tissue's resistance to sliding along the skin (a vertex would otherwise
+// swing round its frame point at constant spring length). The body's rest under given forces is
+// the minimum of E + membrane + sliding - forces . positions, found by Newton's method (each
+// region's rank-one collective Hessian through Woodbury's identity on the sparse rest, factorised
+// by Eigen's simplicial LDL^T).
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drape/body.hpp"
+
+namespace drape {
+
+struct SoftBodyOptions {
+  // Depth of the soft tissue over the frame (each support spring's rest length), m.
+  float depth = 0.03f;
+  // The tissue's stiffness under a flat press: pressure per metre of compression (Pa/m) of one
+  // spring on its own (K C c_i = stiffness x the vertex's area). 2 kPa presses it in 1 cm.
+  float tissue_stiffness = 2.0e5f;
+  // C of eq. 6: the share of a spring's own response beside the region's collective one.
+  float individual = 0.05f;
+  // The tissue's resistance to sliding along the skin, as a share of its stiffness under a press
+  // (a spring to the frame keeps its length as the vertex swings round it: this holds it).
+  float shear = 0.5f;
+  // The membrane: springs along the surface's edges, as stiff as this (N/m) per metre of edge
+  // length over the edge's rest length (a sheet's tension per unit strain).
+  float membrane = 40.0f;
+};
+
+struct SoftRegion {
+  std::string name;                // belly, buttocks, left_thigh, right_thigh, bust, left_upper_arm, right_upper_arm
+  std::vector<uint32_t> vertices;  // body vertices
+};
+
+struct SoftBody {
+  std::vector<SoftRegion> regions;
+  std::vector<int> region_of;      // per body vertex: index into regions, -1 where it stays put
+  std::vector<Vec3f> rest;         // the body's positions
+  std::vector<Vec3f> frame;        // per body vertex: the inner frame point (soft vertices)
+  std::vector<float> weight;       // per body vertex: c_i
+  std::vector<float> area;         // per body vertex: a third of its triangles' area, m^2
+  std::vector<std::array<uint32_t, 2>> edges;  // membrane springs with at least one soft end
+  std::vector<float> edge_rest;
+  SoftBodyOptions options;
+  float collective = 0;            // K
+  size_t soft_count() const;
+};
+
+// The soft regions of `body` (its landmarks and parts) with their springs.
+SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options = {});
+
+struct SoftRegionState {
+  std::string name;
+  size_t vertices = 0;
+  double volume_change = 0;  // fraction of the region's tissue volume (its area x depth)
+  float compression_m = 0;   // the deepest a vertex was pressed in (along its rest normal)
+  float bulge_m = 0;         // the farthest a vertex moved out
+};
+
+struct SoftSolve {
+  std::vector<Vec3f> positions;  // every body vertex
+  std::vector<SoftRegionState> regions;
+  int newton_iterations = 0;
+  double residual_n = 0;         // largest force left on a soft vertex, N
+};
+
+// The body at rest under `forces` (N per body vertex, e.g. the cloth's pressure), Newton's method
+// from `start` (the rest shape when empty). Static vertices keep their rest positions.
+SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, std::span<const Vec3f> start = {});
+
+// The regions' volume change and compression for `positions` (every body vertex).
+std::vector<SoftRegionState> soft_region_states(const SoftBody& soft, std::span<const Vec3f> positions);
+
+}  // namespace drape

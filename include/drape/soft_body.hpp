@@ -66,6 +66,9 @@ struct SoftBody {
 
 // The soft regions of `body` (its landmarks and parts) with their springs.
 SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options = {});
+// Any mesh with its soft regions given: `labels[v]` indexes `names` (-1: the vertex stays put).
+SoftBody make_soft_body(const Mesh& mesh, std::span<const int> labels, const std::vector<std::string>& names,
+                        const SoftBodyOptions& options = {});
 
 struct SoftRegionState {
   std::string name;
@@ -79,6 +82,7 @@ struct SoftSolve {
   std::vector<Vec3f> positions;  // every body vertex
   std::vector<SoftRegionState> regions;
   int newton_iterations = 0;
+  int factorisations = 0;        // of the Hessian: kept across iterations while they converge fast
   double residual_n = 0;         // largest force left on a soft vertex, N
 };
 

@@ -5,6 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace drape {
@@ -19,7 +20,7 @@ float along(const Vec3f& p, const Vec3f& a, const Vec3f& b) {
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
-constexpr double kConverged = 1e-6;  // N: the largest force left on a soft vertex
+constexpr double kConverged = 1e-5;  // N: the largest force left on a soft vertex
 
 // A spring's Hessian from its length l, rest length L and unit direction u, kept positive
 // semi-definite: k u u^T, plus k (1 - L / l) (I - u u^T) while it is stretched.
@@ -36,10 +37,10 @@ size_t SoftBody::soft_count() const {
   return static_cast<size_t>(std::count_if(region_of.begin(), region_of.end(), [](int r) { return r >= 0; }));
 }
 
-SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options) {
+SoftBody make_soft_body(const Mesh& mesh, std::span<const int> labels, const std::vector<std::string>& names,
+                        const SoftBodyOptions& options) {
   SoftBody soft;
   soft.options = options;
-  const Mesh& mesh = body.mesh;
   const size_t n = mesh.positions.size();
   soft.rest = mesh.positions;
   soft.region_of.assign(n, -1);
@@ -51,50 +52,29 @@ SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options) {
     const float a = 0.5f * (mesh.positions[t[1]] - mesh.positions[t[0]]).cross(mesh.positions[t[2]] - mesh.positions[t[0]]).norm();
     for (uint32_t v : t) soft.area[v] += a / 3.0f;
   }
-
-  // The regions, from the landmarks and the body parts (front is +Z, up +Y).
-  const Landmarks& lm = body.landmarks;
-  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
-  const char* names[] = {"belly", "buttocks", "left_thigh", "right_thigh", "bust", "left_upper_arm", "right_upper_arm"};
-  for (const char* name : names) soft.regions.push_back({name, {}});
-  const bool parts = body.parts.size() == n;
-  for (size_t v = 0; v < n && parts; ++v) {
-    const Vec3f& p = mesh.positions[v];
-    const Vec3f& nv = normals[v];
-    const BodyPart part = body.parts[v];
-    int region = -1;
-    if (part == BodyPart::Torso && nv.z() > 0.3f && p.y() > lm.hip.y() && p.y() < lm.underbust.y()) {
-      region = 0;  // belly: the front between the hips and the bust; its sides (the hip bones) stay
-    } else if ((part == BodyPart::Torso || part == BodyPart::LeftLeg || part == BodyPart::RightLeg) && nv.z() < -0.3f &&
-               p.y() > lm.crotch.y() - 0.06f && p.y() < lm.hip.y() + 0.06f) {
-      region = 1;  // buttocks
-    } else if ((part == BodyPart::LeftLeg || part == BodyPart::RightLeg) && p.y() > lm.left_knee.y() + 0.08f &&
-               p.y() < lm.crotch.y() && std::abs(nv.x()) < 0.9f) {
-      region = part == BodyPart::LeftLeg ? 2 : 3;  // thighs, above the knee
-    } else if (part == BodyPart::Torso && nv.z() > 0.3f && p.y() >= lm.underbust.y() && p.y() < bust_y + 0.08f &&
-               std::abs(p.x()) > 0.03f) {
-      region = 4;  // bust, off the breastbone
-    } else if (part == BodyPart::LeftArm || part == BodyPart::RightArm) {
-      const bool left = part == BodyPart::LeftArm;
-      const float s = along(p, left ? lm.left_shoulder : lm.right_shoulder, left ? lm.left_elbow : lm.right_elbow);
-      if (s > 0.25f && s < 0.85f) region = left ? 5 : 6;  // upper arm, off the shoulder and the elbow
-    }
-    if (region < 0) continue;
-    soft.region_of[v] = region;
-    soft.regions[static_cast<size_t>(region)].vertices.push_back(static_cast<uint32_t>(v));
-    soft.frame[v] = p - options.depth * nv;
+  // Regions in the order of `names`, without the empty ones.
+  std::vector<int> renumber(names.size(), -1);
+  for (size_t v = 0; v < n && v < labels.size(); ++v) {
+    const int label = labels[v];
+    if (label < 0 || static_cast<size_t>(label) >= names.size()) continue;
+    if (renumber[static_cast<size_t>(label)] < 0) renumber[static_cast<size_t>(label)] = 0;
   }
-  soft.regions.erase(std::remove_if(soft.regions.begin(), soft.regions.end(), [](const SoftRegion& r) { return r.vertices.empty(); }),
-                     soft.regions.end());
-  std::fill(soft.region_of.begin(), soft.region_of.end(), -1);
-  double area_sum = 0;
-  size_t count = 0;
-  for (size_t r = 0; r < soft.regions.size(); ++r)
-    for (uint32_t v : soft.regions[r].vertices) {
-      soft.region_of[v] = static_cast<int>(r);
-      area_sum += soft.area[v];
-      ++count;
+  for (size_t k = 0; k < names.size(); ++k)
+    if (renumber[k] >= 0) {
+      renumber[k] = static_cast<int>(soft.regions.size());
+      soft.regions.push_back({names[k], {}});
     }
+  double area_sum = 0;
+  for (size_t v = 0; v < n && v < labels.size(); ++v) {
+    const int label = labels[v];
+    if (label < 0 || static_cast<size_t>(label) >= names.size()) continue;
+    const int r = renumber[static_cast<size_t>(label)];
+    soft.region_of[v] = r;
+    soft.regions[static_cast<size_t>(r)].vertices.push_back(static_cast<uint32_t>(v));
+    soft.frame[v] = mesh.positions[v] - options.depth * normals[v];
+    area_sum += soft.area[v];
+  }
+  const size_t count = soft.soft_count();
   const double mean_area = count ? area_sum / static_cast<double>(count) : 1.0;
   for (size_t v = 0; v < n; ++v)
     if (soft.region_of[v] >= 0) soft.weight[v] = static_cast<float>(soft.area[v] / mean_area);
@@ -111,6 +91,41 @@ SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options) {
       soft.edge_rest.push_back((mesh.positions[a] - mesh.positions[b]).norm());
     }
   return soft;
+}
+
+SoftBody make_soft_body(const Body& body, const SoftBodyOptions& options) {
+  const Mesh& mesh = body.mesh;
+  const size_t n = mesh.positions.size();
+  const std::vector<Vec3f> normals = vertex_normals(mesh.positions, mesh.triangles);
+  // The regions, from the landmarks and the body parts (front is +Z, up +Y).
+  const Landmarks& lm = body.landmarks;
+  const float bust_y = 0.5f * (lm.left_bust.y() + lm.right_bust.y());
+  const std::vector<std::string> names{"belly", "buttocks", "left_thigh", "right_thigh", "bust", "left_upper_arm", "right_upper_arm"};
+  std::vector<int> labels(n, -1);
+  const bool parts = body.parts.size() == n;
+  for (size_t v = 0; v < n && parts; ++v) {
+    const Vec3f& p = mesh.positions[v];
+    const Vec3f& nv = normals[v];
+    const BodyPart part = body.parts[v];
+    int& region = labels[v];
+    if (part == BodyPart::Torso && nv.z() > 0.3f && p.y() > lm.hip.y() && p.y() < lm.underbust.y()) {
+      region = 0;  // belly: the front between the hips and the bust; its sides (the hip bones) stay
+    } else if ((part == BodyPart::Torso || part == BodyPart::LeftLeg || part == BodyPart::RightLeg) && nv.z() < -0.3f &&
+               p.y() > lm.crotch.y() - 0.06f && p.y() < lm.hip.y() + 0.06f) {
+      region = 1;  // buttocks
+    } else if ((part == BodyPart::LeftLeg || part == BodyPart::RightLeg) && p.y() > lm.left_knee.y() + 0.08f &&
+               p.y() < lm.crotch.y() && std::abs(nv.x()) < 0.9f) {
+      region = part == BodyPart::LeftLeg ? 2 : 3;  // thighs, above the knee
+    } else if (part == BodyPart::Torso && nv.z() > 0.3f && p.y() >= lm.underbust.y() && p.y() < bust_y + 0.08f &&
+               std::abs(p.x()) > 0.03f) {
+      region = 4;  // bust, off the breastbone
+    } else if (part == BodyPart::LeftArm || part == BodyPart::RightArm) {
+      const bool left = part == BodyPart::LeftArm;
+      const float s = along(p, left ? lm.left_shoulder : lm.right_shoulder, left ? lm.left_elbow : lm.right_elbow);
+      if (s > 0.25f && s < 0.85f) region = left ? 5 : 6;  // upper arm, off the shoulder and the elbow
+    }
+  }
+  return make_soft_body(mesh, labels, names, options);
 }
 
 std::vector<SoftRegionState> soft_region_states(const SoftBody& soft, std::span<const Vec3f> positions) {
@@ -199,11 +214,12 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
   };
 
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
-  bool analysed = false;
+  bool analysed = false, factored = false;
+  double last_residual = std::numeric_limits<double>::infinity();
   std::vector<double> dl_tot;
   double energy = energy_of(x, &dl_tot);
   std::vector<Eigen::Triplet<double>> triplets;
-  for (int iteration = 0; iteration < 50; ++iteration) {
+  for (int iteration = 0; iteration < 80; ++iteration) {
     Eigen::VectorXd gradient = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));
     std::vector<Eigen::VectorXd> collective(regions, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m)));
     triplets.clear();
@@ -256,14 +272,24 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     out.residual_n = largest;
     if (largest < kConverged) break;
 
-    Eigen::SparseMatrix<double> H(static_cast<Eigen::Index>(3 * m), static_cast<Eigen::Index>(3 * m));
-    H.setFromTriplets(triplets.begin(), triplets.end());
-    if (!analysed) {
-      solver.analyzePattern(H);
-      analysed = true;
+    // The factorisation is most of a Newton iteration's cost: it is kept while full steps go on
+    // cutting the residual by 30 % or more (the Hessian changes little near the rest; with the
+    // compressed springs' negative curvature left out, fresh ones converge linearly too, about
+    // halving it), and made anew otherwise.
+    const bool refactor = !factored || largest > 0.7 * last_residual;
+    last_residual = largest;
+    if (refactor) {
+      Eigen::SparseMatrix<double> H(static_cast<Eigen::Index>(3 * m), static_cast<Eigen::Index>(3 * m));
+      H.setFromTriplets(triplets.begin(), triplets.end());
+      if (!analysed) {
+        solver.analyzePattern(H);
+        analysed = true;
+      }
+      solver.factorize(H);
+      if (solver.info() != Eigen::Success) break;
+      factored = true;
+      ++out.factorisations;
     }
-    solver.factorize(H);
-    if (solver.info() != Eigen::Success) break;
     // (H + K A A^T)^-1 g by Woodbury's identity, A holding one column per region (a few: the
     // products are taken column by column).
     const Eigen::VectorXd hg = solver.solve(gradient);
@@ -286,13 +312,20 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     double alpha = 1.0, trial_energy = energy;
     std::vector<double> trial_tot;
     bool lower = false;
-    for (int tries = 0; tries < 30 && !lower; ++tries, alpha *= 0.5) {
+    for (int tries = 0; tries < 30; ++tries) {
       for (size_t s = 0; s < m; ++s) trial[vertex[s]] = x[vertex[s]] + alpha * step.segment<3>(static_cast<Eigen::Index>(3 * s));
       trial_energy = energy_of(trial, &trial_tot);
       lower = trial_energy <= energy;
+      if (lower) break;
+      alpha *= 0.5;
     }
     ++out.newton_iterations;
+    if (!lower && !refactor) {
+      factored = false;  // the kept factorisation led nowhere: a fresh one
+      continue;
+    }
     if (!lower) break;
+    if (alpha < 0.75) factored = false;  // a shortened step: the Hessian has moved on
     x.swap(trial);
     dl_tot.swap(trial_tot);
     energy = trial_energy;

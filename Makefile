@@ -38,7 +38,8 @@ sanitize: deps
 	cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRAPE_SANITIZE=address,undefined \
 	  -DDRAPE_BENCH=OFF -DDRAPE_WERROR=$(WERROR) $(CMAKE_FLAGS)
 	cmake --build build-asan -j $(JOBS)
-	cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 DRAPE_SANITIZED=1 \
+	cd build-asan && ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tools/lsan.supp \
+	  UBSAN_OPTIONS=print_stacktrace=1 DRAPE_SANITIZED=1 \
 	  ctest --output-on-failure -j $(JOBS)
 
 # libFuzzer targets, one per parser a user's file reaches (clang-14), in build-fuzz/.

@@ -136,17 +136,17 @@ void run_animate(const AnimateArgs& a) {
 void add_animate_command(CLI::App& app) {
   auto args = std::make_shared<AnimateArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "animate", "Dress a body, retarget a motion (BVH, glTF/GLB) onto its rig and simulate the garments on the moving body");
+      "animate", "Dress a body, retarget a motion (BVH, FBX, glTF/GLB) onto its rig and simulate the garments on the moving body");
   cmd->add_option("--body", args->body, "female, male (built-in bodies) or a body file (rigged glTF/GLB, or a scan: rigged from its landmarks)")
       ->capture_default_str();
   cmd->add_option("--garment", args->garments,
                   "built-in garment name (see `drape garments`) or garment file; repeat for layers, outermost last");
   cmd->add_option("--size", args->sizes, "size to make (one for all garments, or one per --garment); default: from the size chart");
-  cmd->add_option("--motion", args->motion, "motion file: BVH, or glTF/GLB with an animation")->required();
+  cmd->add_option("--motion", args->motion, "motion file: BVH, FBX (Mixamo's format) or glTF/GLB with an animation")->required();
   cmd->add_option("--joint-map", args->joint_map,
                   "JSON file naming the motion's joint for each joint drape drives, {\"Hips\": \"pelvis\", ...} "
                   "(default: found from the names; docs/animation.md)");
-  cmd->add_option("--motion-up", args->motion_up, "the motion file's up axis: auto (from its skeleton), y or z")
+  cmd->add_option("--motion-up", args->motion_up, "the motion file's up axis: auto (FBX: the file's; else from its skeleton), y or z")
       ->capture_default_str()->check(CLI::IsMember({"auto", "y", "z"}));
   cmd->add_option("--fps", args->fps, "frames per second of the animation (the motion is resampled)")
       ->capture_default_str()->check(CLI::Range(1.0, 240.0));

@@ -11,6 +11,7 @@ packages=(
   libembree-dev libtbb-dev libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libbullet-dev                                         # the peer engine benchmarked beside drape
+  libassimp-dev zlib1g-dev                              # FBX motions (Mixamo's format)
   nodejs npm                                            # the Khronos glTF validator, the web page's three.js
   libcpp-httplib-dev libhiredis-dev redis-server        # drape serve: HTTP, the shared Redis queue
   chromium                                              # the web page's browser test (headless)

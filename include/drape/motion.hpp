@@ -1,5 +1,5 @@
 #pragma once
-// Motion capture onto drape's bodies: motion files (BVH, glTF/GLB animations), the joint names of
+// Motion capture onto drape's bodies: motion files (BVH, FBX, glTF/GLB animations), the joint names of
 // the skeletons people have, retargeting a motion onto a body's rig, and skinning the body's mesh
 // to a pose (linear blend and dual quaternion). See docs/animation.md.
 //
@@ -9,9 +9,10 @@
 //   skin_mesh(body, a.pose(10), Skinning::Linear, x);    // the body's vertices in frame 10
 //
 // Frames: a motion is converted on load to drape's axes (+Y up, facing +Z, +X = the subject's
-// left). Its lengths stay in the file's units: retargeting uses the motion's rotations and its
-// root motion scaled by the ratio of the body's leg length to the motion skeleton's, so a motion's
-// unit never has to be known (BVH has no unit field; CMU's is 0.056444 m, MakeHuman's decimetres).
+// left). Its lengths stay in the file's units (FBX's are converted to metres, the file says its
+// unit): retargeting uses the motion's rotations and its root motion scaled by the ratio of the
+// body's leg length to the motion skeleton's, so a motion's unit never has to be known (BVH has no
+// unit field; CMU's is 0.056444 m, MakeHuman's decimetres).
 #include <Eigen/Geometry>
 #include <filesystem>
 #include <span>
@@ -27,8 +28,9 @@ namespace drape {
 
 using Quatf = Eigen::Quaternionf;
 
-// The motion file's up axis. Auto: measured from the rest skeleton (the axis from the hips to the
-// head); BVH has no field for it (MakeHuman's poses are Z-up, CMU's Y-up).
+// The motion file's up axis. Auto: FBX's own (its UpAxis), else measured from the rest skeleton
+// (the axis from the hips to the head); BVH has no field for it (MakeHuman's poses are Z-up, CMU's
+// Y-up).
 enum class MotionUp : uint8_t { Auto, Y, Z };
 
 struct MotionOptions {
@@ -36,10 +38,10 @@ struct MotionOptions {
 };
 
 // A skeletal motion: joints with a rest pose, and per frame every joint's local transform.
-// Everything is in drape's axes; lengths in the file's units.
+// Everything is in drape's axes; lengths in the file's units (FBX: metres).
 struct Motion {
   std::string source;                // the file, for messages
-  std::string format;                // "bvh" or "gltf"
+  std::string format;                // "bvh", "fbx" or "gltf"
   UpAxis up = UpAxis::Y;             // what the file used (converted from)
   std::vector<std::string> names;    // joint names as the file spells them
   std::vector<int> parent;           // -1 for a root; a parent precedes its children
@@ -70,8 +72,13 @@ Motion parse_bvh(std::string_view text, const std::string& source, const MotionO
 // (at most 1/120 s apart). InputError(source, ...) when the scene has no animation of nodes.
 Motion motion_from_scene(const Scene& scene, const std::string& source, const MotionOptions& options = {});
 
-// Reads .bvh, .glb or .gltf by extension (case-insensitive). FBX (Mixamo's format) is refused with
-// a message saying to convert it to glTF or BVH: see motion_io.cpp for why.
+// Reads .bvh, .fbx, .glb or .gltf by extension (case-insensitive). FBX (Mixamo's format, binary or
+// ASCII) is read through Assimp: the first animation, sampled at the most common spacing of its keys
+// (1/120 to 1/30 s); the joints are the nodes that deform a mesh or that the animation moves;
+// Assimp's "$AssimpFbx$" helper nodes (pre-rotations, pivots) are folded into their joints; lengths
+// are converted to metres with the file's UnitScaleFactor and the file's up axis is used (see
+// src/anim/fbx_motion.cpp). InputError(path, ...) for a file Assimp refuses (with its reason), one
+// without animation or skeleton, or one beyond what drape lets Assimp read (fbx_limits.cpp).
 Motion read_motion(const std::filesystem::path& path, const MotionOptions& options = {});
 
 // ---- Skeletons people have, and joint maps ------------------------------------------------------

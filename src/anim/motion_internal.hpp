@@ -1,5 +1,7 @@
 #pragma once
 // Internal to src/anim: helpers shared by the motion readers, retargeting and skinning.
+#include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +17,16 @@ std::string printable(std::string_view token);
 // skeleton when options say Auto (the hips-to-head direction, where the joint names are known),
 // then rotates a Z-up motion (x, y, z) -> (x, z, -y) as LoadOptions does for meshes.
 void convert_axes(Motion& motion, const MotionOptions& options);
+
+// FBX through Assimp (fbx_motion.cpp): the first animation of the file, its helper nodes folded into
+// their joints, lengths in metres, the file's up axis unless options give one. InputError(source, ...)
+// for a file Assimp refuses (with its reason), one without animation or skeleton, or larger than
+// drape reads.
+Motion parse_fbx(std::span<const unsigned char> bytes, const std::string& source, const MotionOptions& options);
+Motion read_fbx(const std::filesystem::path& path, const std::string& source, const MotionOptions& options);
+// Refuses, before Assimp reads it, an FBX file that would make Assimp 5.2 take more memory than its
+// size warrants, loop forever or recurse too deep (fbx_limits.cpp says how).
+void check_fbx_limits(std::span<const unsigned char> bytes, const std::string& source);
 
 // Index of a canonical joint (canonical_joints() order) by name; -1 when not canonical.
 int canonical_index(std::string_view name);

@@ -1,9 +1,5 @@
-// Motion files by extension, the up-axis conversion, and motions from glTF animations.
-//
-// FBX (Mixamo's format) is not read. Debian's Assimp (libassimp-dev) reads it, but it is not among
-// drape's build dependencies, and its FBX importer gives skeletons with Mixamo's pre-rotations baked
-// into extra "$AssimpFbx$" helper nodes whose rest pose is not the bind pose; Blender and Mixamo both
-// export glTF/GLB, which drape reads with the same tinygltf code as its meshes.
+// Motion files by extension, the up-axis conversion, and motions from glTF animations. BVH is
+// parsed in bvh.cpp, FBX (Mixamo's format) read through Assimp in fbx_motion.cpp.
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -212,11 +208,10 @@ Motion read_motion(const std::filesystem::path& path, const MotionOptions& optio
   std::string ext = path.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   const std::string source = path.string();
-  if (ext == ".fbx")
-    throw InputError(source, "FBX is not read: export the motion as glTF/GLB (Blender, Mixamo) or BVH");
-  if (ext != ".bvh" && ext != ".glb" && ext != ".gltf")
-    throw InputError(source, "not a motion file drape reads (.bvh, .glb, .gltf)");
+  if (ext != ".bvh" && ext != ".glb" && ext != ".gltf" && ext != ".fbx")
+    throw InputError(source, "not a motion file drape reads (.bvh, .fbx, .glb, .gltf)");
   if (!std::filesystem::is_regular_file(path)) throw InputError(source, "no such motion file");
+  if (ext == ".fbx") return motion_detail::read_fbx(path, source, options);
   if (ext == ".bvh") {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(source, "cannot open the motion file");

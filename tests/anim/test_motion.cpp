@@ -222,12 +222,13 @@ TEST(JointMaps, FromAFile) {
   EXPECT_THROW(parse_joint_map("[1, 2", "map.json", names), InputError);
 }
 
-TEST(Motion, FbxIsRefusedWithAWayOut) {
+TEST(Motion, AnUnknownExtensionIsRefusedNamingTheFormatsRead) {
   try {
-    read_motion("dance.fbx");
+    read_motion("dance.c3d");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("glTF"), std::string::npos);
+    EXPECT_EQ(e.source(), "dance.c3d");
+    EXPECT_NE(std::string(e.what()).find(".bvh, .fbx, .glb, .gltf"), std::string::npos) << e.what();
   }
 }
 

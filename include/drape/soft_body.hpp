@@ -10,14 +10,15 @@
 //
 //   l_tot = sum_i c_i l_i,    f_i = -c_i K (dl_tot + C dl_i) u_i,
 //
-// c_i = the vertex's area over the mean vertex area, u_i the unit vector from the frame point to
-// the vertex, K the collective stiffness and C in (0, 1) the share of each spring's own response:
+// c_i = the vertex's area over the mean vertex area, u_i the spring's direction (the vertex's rest
+// normal: the springs are perpendicular to the surface, and each one's length l_i is measured
+// along it), K the collective stiffness and C in (0, 1) the share of each spring's own response:
 // pressed in one place, a region bulges elsewhere and keeps its volume. Eq. 6 is the gradient of
 //
 //   E = K/2 (dl_tot^2 + C sum_i c_i dl_i^2),
 //
-// to which drape adds the tissue's resistance to sliding along the skin (a vertex would otherwise
-// swing round its frame point at constant spring length). The body's rest under given forces is
+// to which drape adds the tissue's resistance to sliding along the skin (the springs hold a vertex
+// only along their direction). The body's rest under given forces is
 // the minimum of E + membrane + sliding - forces . positions, found by Newton's method (each
 // region's rank-one collective Hessian through Woodbury's identity on the sparse rest, factorised
 // by Eigen's simplicial LDL^T).
@@ -33,12 +34,14 @@ struct SoftBodyOptions {
   // Depth of the soft tissue over the frame (each support spring's rest length), m.
   float depth = 0.03f;
   // The tissue's stiffness under a flat press: pressure per metre of compression (Pa/m) of one
-  // spring on its own (K C c_i = stiffness x the vertex's area). 2 kPa presses it in 1 cm.
-  float tissue_stiffness = 2.0e5f;
+  // spring on its own (K C c_i = stiffness x the vertex's area). 1 kPa presses it in 1 cm: soft
+  // tissue with a Young's modulus of about 3 kPa (fat; muscle at rest is a few times stiffer) over
+  // the 3 cm depth.
+  float tissue_stiffness = 1.0e5f;
   // C of eq. 6: the share of a spring's own response beside the region's collective one.
   float individual = 0.05f;
   // The tissue's resistance to sliding along the skin, as a share of its stiffness under a press
-  // (a spring to the frame keeps its length as the vertex swings round it: this holds it).
+  // (the support springs hold a vertex only along the normal, the membrane only where stretched).
   float shear = 0.5f;
   // The membrane: springs along the surface's edges, as stiff as this (N/m) per metre of edge
   // length over the edge's rest length (a sheet's tension per unit strain).

@@ -176,7 +176,10 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
   const double k_membrane = soft.options.membrane;
   const size_t regions = soft.regions.size();
   const auto force = [&](uint32_t v) -> Vec3 { return v < forces.size() ? Vec3(forces[v].cast<double>()) : Vec3(Vec3::Zero()); };
-  // Each support spring's rest length (its length in the rest shape) and direction.
+  // Each support spring's direction (the rest normal) and rest length. Its length is measured
+  // along that direction: a spring perpendicular to the surface, as the paper has it, whose
+  // energy stays convex however deep the press (measured point to point, a vertex pushed past its
+  // frame point would find the spring's rest length again on the other side).
   std::vector<double> rest_length(n, 0.0);
   std::vector<Vec3> normal(n, Vec3::Zero());
   for (uint32_t v : vertex) {
@@ -184,8 +187,8 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     rest_length[v] = d.norm();
     normal[v] = d / std::max(rest_length[v], 1e-12);
   }
-  // The tissue's resistance to sliding along the skin, per unit c_i: without it a vertex could
-  // swing round its frame point (the support spring keeps its length) and dive in.
+  // The tissue's resistance to sliding along the skin, per unit c_i: the support springs hold a
+  // vertex only along their direction, the membrane only where it is stretched.
   const double k_shear = soft.options.shear * K * C;
   std::vector<double> edge_rest(soft.edges.size());
   for (size_t k = 0; k < soft.edges.size(); ++k)
@@ -196,7 +199,7 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     double e = 0;
     std::vector<double> tot(regions, 0.0);
     for (uint32_t v : vertex) {
-      const double dl = (p[v] - soft.frame[v].cast<double>()).norm() - rest_length[v];
+      const double dl = (p[v] - soft.frame[v].cast<double>()).dot(normal[v]) - rest_length[v];
       tot[static_cast<size_t>(soft.region_of[v])] += soft.weight[v] * dl;
       e += 0.5 * K * C * soft.weight[v] * dl * dl;
       const Vec3 moved = p[v] - soft.rest[v].cast<double>();
@@ -230,11 +233,9 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     for (size_t s = 0; s < m; ++s) {
       const uint32_t v = vertex[s];
       const auto r = static_cast<size_t>(soft.region_of[v]);
-      const Vec3 d = x[v] - soft.frame[v].cast<double>();
-      const double l = std::max(d.norm(), 1e-9);
-      const Vec3 u = d / l;
+      const Vec3& u = normal[v];
       const double c = soft.weight[v];
-      const double dl = l - rest_length[v];
+      const double dl = (x[v] - soft.frame[v].cast<double>()).dot(u) - rest_length[v];
       const auto at = static_cast<Eigen::Index>(3 * s);
       // Eq. 6 (its negative: the energy's gradient) and the applied force.
       gradient.segment<3>(at) += c * K * (dl_tot[r] + C * dl) * u - force(v);
@@ -242,9 +243,7 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
       const Vec3 moved = x[v] - soft.rest[v].cast<double>();
       const Mat3 tangent = Mat3::Identity() - normal[v] * normal[v].transpose();
       gradient.segment<3>(at) += k_shear * c * (tangent * moved);
-      Mat3 h = spring_hessian(K * C * c, l, rest_length[v], u) + k_shear * c * tangent;
-      if (dl_tot[r] > 0) h += K * c * dl_tot[r] / l * (Mat3::Identity() - u * u.transpose());
-      add_block(static_cast<int>(s), static_cast<int>(s), h);
+      add_block(static_cast<int>(s), static_cast<int>(s), K * C * c * u * u.transpose() + k_shear * c * tangent);
     }
     for (size_t k = 0; k < soft.edges.size(); ++k) {
       const auto [a, b] = soft.edges[k];

@@ -202,12 +202,12 @@ struct SoftBodyResult {
 };
 
 struct DressResult {
-  std::optional<SoftBodyResult> soft_body;
   std::vector<DressedGarment> garments;  // innermost first
   FitQuality quality;
   SimulationSummary simulation;
   std::vector<GateResult> gates;
   double setup_seconds = 0;  // body analysis, meshing, placement, colliders (not in Table 2's times)
+  std::optional<SoftBodyResult> soft_body;  // with DressOptions::soft_body
   bool passed() const { return all_passed(gates); }
 };
 

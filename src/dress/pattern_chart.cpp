@@ -74,18 +74,14 @@ std::vector<PatternGirth> pattern_girths(const Body& body, const DressedGarment&
   const size_t n = model.particle_count();
   const std::span<const Vec3f> x = placed.state.x;
   const size_t panels = std::min(garment.panels.size(), placed.panel_first_vertex.empty() ? 0 : placed.panel_first_vertex.size() - 1);
+  // Which particles are on a sleeve or a leg: as the fit reads them (fit_garment).
+  const FitGarment flags = fit_garment(placed, garment);
+  const std::vector<uint8_t>& arm = flags.on_arm;
+  const std::vector<uint8_t>& leg = flags.on_leg;
   std::vector<uint32_t> panel_of(n, 0);
-  std::vector<uint8_t> arm(n, 0), leg(n, 0);
-  for (size_t p = 0; p < panels; ++p) {
-    const std::optional<PlacementHint>& h = garment.panels[p].placement;
-    const bool on_arm = h && (h->body_part == BodyRegion::left_arm || h->body_part == BodyRegion::right_arm);
-    const uint8_t on_leg = !h ? 0 : h->body_part == BodyRegion::left_leg ? 1 : h->body_part == BodyRegion::right_leg ? 2 : 0;
-    for (uint32_t i = placed.panel_first_vertex[p]; i < placed.panel_first_vertex[p + 1] && i < n; ++i) {
+  for (size_t p = 0; p < panels; ++p)
+    for (uint32_t i = placed.panel_first_vertex[p]; i < placed.panel_first_vertex[p + 1] && i < n; ++i)
       panel_of[i] = static_cast<uint32_t>(p);
-      arm[i] = on_arm;
-      leg[i] = on_leg;
-    }
-  }
 
   // The torso's panels in rings: panels sewn side to side by vertical seams (a seam whose side runs
   // farther down than across). A bodice and a skirt sewn at the waist are two rings, which

@@ -16,12 +16,7 @@
 namespace drape {
 namespace {
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return nlohmann::json::parse(ss.str());
-}
+using test::read_json;
 
 size_t lines(const std::string& s) {
   size_t n = 0;

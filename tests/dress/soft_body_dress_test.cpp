@@ -7,8 +7,6 @@
 #include <set>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -69,10 +67,7 @@ TEST(SoftBodyDress, ReportSaysWhereTheBodyGaveWay) {
   const auto r = test::run_drape("dress --garment jeans --size M --soft-body --out " + dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("soft body:"), std::string::npos) << r.err;
-  std::ifstream in(dir / "report.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const nlohmann::json j = nlohmann::json::parse(ss.str());
+  const nlohmann::json j = test::read_json(dir / "report.json");
   std::set<std::string> names;
   for (const auto& region : j["soft_body"]["regions"]) {
     names.insert(region["name"].get<std::string>());

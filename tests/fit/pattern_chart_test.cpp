@@ -3,8 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -143,10 +141,7 @@ TEST(PatternChart, FitCommandMakesTheChartFromThePattern) {
   ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.err;
   EXPECT_NE(r.err.find("has no size chart: its pattern made one"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("cut for a body with waist"), std::string::npos) << r.err;
-  std::ifstream in(dir / "report.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const nlohmann::json j = nlohmann::json::parse(ss.str());
+  const nlohmann::json j = test::read_json(dir / "report.json");
   EXPECT_EQ(j["chart_source"], "pattern");
   EXPECT_EQ(j["chart_size"], "as drafted");
   ASSERT_EQ(j["sizes"].size(), 1u);

@@ -343,12 +343,7 @@ std::vector<AdviceCase> advice_cases() {
 }
 INSTANTIATE_TEST_SUITE_P(Bodies, ChartSizeIsRecommended, ::testing::ValuesIn(advice_cases()), advice_case_name);
 
-nlohmann::json read_json(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return nlohmann::json::parse(ss.str());
-}
+using test::read_json;
 
 TEST(FitCli, SkirtOnTheDefaultBodyWritesTheReportAndPictures) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing three sizes is too slow";

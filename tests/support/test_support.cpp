@@ -36,6 +36,13 @@ static std::string slurp(const std::filesystem::path& p) {
   return ss.str();
 }
 
+nlohmann::json read_json(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return nlohmann::json::parse(ss.str());
+}
+
 CommandResult run_drape(const std::string& args) {
   static int counter = 0;
   auto dir = std::filesystem::temp_directory_path() /

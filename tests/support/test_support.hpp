@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace drape::test {
 
 // ../shared/data (absolute), or an empty path when it is absent (a user's fresh clone).
@@ -27,5 +29,8 @@ struct CommandResult {
 };
 // Runs build/drape with the given argument string (shell-quoted by the caller).
 CommandResult run_drape(const std::string& args);
+
+// A JSON file (a command's report.json), parsed.
+nlohmann::json read_json(const std::filesystem::path& path);
 
 }  // namespace drape::test

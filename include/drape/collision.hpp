@@ -41,9 +41,11 @@ struct BodyColliderOptions {
   // sdf: grid spacing (metres) and the half width of the narrow band that is stored exactly.
   float voxel_size = 0.004f;
   float band = 0.02f;
-  // bvh: index the space near the body (a candidate list per 1 cm cell) for fast queries. It takes
-  // about 0.2 s on a 27k-triangle body and pays off over a simulation; a few thousand queries
-  // (measuring a dressed garment) are cheaper straight from the tree.
+  // bvh, and image's hidden pixels: index the space near the body (a candidate list per 7 mm cell)
+  // for fast queries. It takes about 0.2 s on a 20k-triangle body and pays off over the explicit
+  // step's thousands of iterations; a few thousand queries (measuring a dressed garment) or the
+  // implicit solver's (contacts found anew only where a particle moved 1 mm: 0.02 s of the default
+  // shirt's dressing) are cheaper straight from the tree.
   bool candidate_grid = true;
 };
 

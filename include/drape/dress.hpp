@@ -23,6 +23,7 @@
 #include "drape/fabric.hpp"
 #include "drape/fit.hpp"
 #include "drape/garment.hpp"
+#include "drape/garment_transfer.hpp"
 #include "drape/implicit.hpp"
 #include "drape/scene.hpp"
 #include "drape/soft_body.hpp"
@@ -120,6 +121,11 @@ struct DressOptions {
   SoftBodyOptions soft;
   int soft_body_rounds = 4;
   float soft_body_settled_m = 0.0005f;
+  // Garments dressed before on other bodies of this body's mesh (drape/garment_transfer.hpp): a
+  // garment with a matching transfer (its name, size and particle count, the body's mesh) starts
+  // where the first such transfer puts it on this body instead of from its placement, and drapes
+  // from there. The implicit solver only.
+  std::vector<std::shared_ptr<const GarmentTransfer>> transfers;
 };
 
 // Where a panel ended up and why.
@@ -165,7 +171,9 @@ struct DressedGarment {
   double sewing_seconds = 0, drape_seconds = 0;  // wall
   bool seams_closed = false, settled = false;
   StepStatus status = StepStatus::Ok;
-  float initial_max_gap = 0;   // m, right after placement (prepare_garment)
+  float initial_max_gap = 0;   // m, right after placement (prepare_garment) or the transfer
+  bool transferred = false;    // started from a garment dressed on another body (DressOptions::transfers)
+  bool transfer_failed = false;  // a transferred start ended outside the gates: dressed again from the placement
   float time_step = 0;         // s
   float placed_centre_y = 0, sewn_centre_y = 0, final_centre_y = 0;  // m, the centre of mass's height
   StepProfile profile;                // explicit solver
@@ -234,6 +242,12 @@ SizeChoice choose_size(const GarmentSpec& spec, const Measurements& body);
 DressedGarment prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
                                const DressOptions& options);
 
+// Instead of its placement, the garment starts where the first matching transfer puts it on `body`,
+// every particle at least the fabric's thickness outside it (DressedGarment::transferred says
+// whether one matched).
+void start_from_transfer(DressedGarment& garment, const Body& body, const Collider& body_collider,
+                         std::span<const std::shared_ptr<const GarmentTransfer>> transfers);
+
 // Stages 5: sews then drapes `garment` on the colliders (body first, then dressed garments).
 void sew_and_drape(DressedGarment& garment, std::span<Collider* const> colliders, const DressOptions& options,
                    const DressProgressCallback& progress = {}, size_t index = 0, size_t count = 1);
@@ -246,7 +260,7 @@ void sew_and_drape_implicit(DressedGarment& garment, std::span<Collider* const> 
 std::unique_ptr<Collider> garment_collider(const DressedGarment& garment);
 
 // Stage 7: quality over all garments against the body.
-FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garments);
+FitQuality measure_fit(const Body& body, std::span<const DressedGarment> garments);
 
 // The whole pipeline. Layer order = request order (innermost first). Throws InputError for bad
 // garments (naming the file) and for meshing failures.

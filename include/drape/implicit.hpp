@@ -10,8 +10,9 @@
 //        + sum_i mu lambda_i f(|T_i (x_i - x_n,i)|)     Coulomb friction, lagged (IPC's smoothing)
 //        - sum_i m_i g . x_i                            gravity
 //
-// by Newton's method (Baraff & Witkin 1998 without their one-iteration shortcut): a spring's
-// Hessian made positive semi-definite by dropping its compressive transverse term, the sparse
+// by Newton's method (Baraff & Witkin 1998 without their one-iteration shortcut): the springs'
+// exact Hessian, or where that is indefinite each spring's made positive semi-definite by dropping
+// its compressive transverse term, the sparse
 // system solved directly (Cholesky with a fill-reducing ordering analysed once per model: the
 // pattern never changes), a backtracking line search on E, and a cap on how far one iteration
 // moves a particle so contacts found at the start of an iteration stay valid for it. Contacts are
@@ -43,6 +44,10 @@ struct ImplicitSettings {
   float seam_stiffness = 2000.0f;       // N/m per sewn pair (a closed seam's zero-length spring)
   float seam_force = 0.0f;              // N, the most one pair pulls with (sewing); 0: no cap
   float max_move = 0.01f;               // m, the most one Newton iteration moves a particle
+  int max_newton_iterations = 12;       // per step
+  // The springs' exact Hessian blocks (a factorisation that fails, where the cloth buckles, falls
+  // back to the projected ones for the rest of the step), else each made positive semi-definite.
+  bool exact_hessian = true;
 };
 // Settings from the model's fabric (friction, threshold).
 ImplicitSettings default_implicit_settings(const ClothModel& model);

@@ -32,7 +32,29 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   return g;
 }
 
-FitQuality measure_fit(const Body& body, const std::vector<DressedGarment>& garments) {
+void start_from_transfer(DressedGarment& g, const Body& body, const Collider& body_collider,
+                         std::span<const std::shared_ptr<const GarmentTransfer>> transfers) {
+  if (transfers.empty()) return;
+  const uint64_t mesh = mesh_fingerprint(body.mesh);
+  for (const auto& t : transfers) {
+    if (!t || !t->matches(g.name, g.size, g.state.x.size(), mesh)) continue;
+    g.state.x = transfer_positions(*t, body.mesh);
+    // Where the new body is fuller, a particle kept at its offset from one triangle can end up in
+    // the body through another (a hem between the legs, nearest one thigh, inside the other): each
+    // particle within the cloth's thickness of the skin, or under it, goes out along the skin's
+    // normal to the thickness, as placement leaves the panels.
+    const float thickness = g.model.fabric.collision_thickness;
+    std::vector<ContactSample> near(g.state.x.size());
+    body_collider.query(g.state.x, 0.05f, near);
+    for (size_t i = 0; i < near.size(); ++i)
+      if (near[i].distance < thickness) g.state.x[i] += (thickness - near[i].distance) * near[i].normal;
+    g.initial_max_gap = seam_gap_stats(g.state.x, g.seam_pairs).max;
+    g.transferred = true;
+    return;
+  }
+}
+
+FitQuality measure_fit(const Body& body, std::span<const DressedGarment> garments) {
   FitQuality q;
   const InsideTest inside(body.mesh);
   std::vector<float> all_strain;
@@ -90,7 +112,10 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   }
 
   auto t0 = clock();
-  std::unique_ptr<BodyCollider> body_collider = make_body_collider(body.mesh, o.collision);
+  // The implicit solver asks for few contacts: the candidate grid would cost more than it saves.
+  BodyColliderOptions collider_options;
+  collider_options.candidate_grid = o.solver != Solver::Implicit;
+  std::unique_ptr<BodyCollider> body_collider = make_body_collider(body.mesh, o.collision, collider_options);
   std::vector<std::unique_ptr<Collider>> layers;
   std::vector<Collider*> colliders{body_collider.get()};
   result.setup_seconds += since(t0);
@@ -101,17 +126,37 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
     t0 = clock();
     DressedGarment g = prepare_garment(body, garments[i], *body_collider, o);
     g.size_reason = size_reasons[i];
+    if (o.solver == Solver::Implicit) start_from_transfer(g, body, *body_collider, o.transfers);
     result.setup_seconds += since(t0);
-    if (o.coarse_edge > 1.25 * o.mesh.edge_length) {
+    if (o.coarse_edge > 1.25 * o.mesh.edge_length && !g.transferred) {
       dressing::dress_coarse_first(g, body, garments[i], *body_collider, colliders, o, progress, i, garments.size());
       result.setup_seconds += g.coarse.setup_seconds;
       result.simulation.iterations += g.coarse.iterations;
       result.simulation.wall_seconds += g.coarse.wall_seconds;
     }
-    if (o.solver == Solver::Implicit)
+    if (o.solver == Solver::Implicit) {
       sew_and_drape_implicit(g, colliders, o, progress, i, garments.size());
-    else
+      // A transferred start that does not end within the gates is dressed again from its
+      // placement: a body fuller at the waist than the one the garment was dressed on holds a
+      // band where it sat there, stretched and pressed into the skin, where one placed anew slides
+      // to where the body's girth matches it.
+      if (g.transferred && !all_passed(evaluate_gates(measure_fit(body, std::span(&g, 1)),
+                                                      g.model.fabric.strain_threshold, o.gates))) {
+        const double tried = g.sewing_seconds + g.drape_seconds;
+        const uint64_t iterations = g.state.iterations;
+        t0 = clock();
+        DressedGarment placed = prepare_garment(body, garments[i], *body_collider, o);
+        placed.size_reason = g.size_reason;
+        result.setup_seconds += since(t0);
+        g = std::move(placed);
+        sew_and_drape_implicit(g, colliders, o, progress, i, garments.size());
+        g.transfer_failed = true;
+        result.simulation.iterations += iterations;
+        result.simulation.wall_seconds += tried;
+      }
+    } else {
       sew_and_drape(g, colliders, o, progress, i, garments.size());
+    }
     result.simulation.iterations += g.state.iterations;
     result.simulation.wall_seconds += g.sewing_seconds + g.drape_seconds;
     result.simulation.time_step_s = std::max(result.simulation.time_step_s, static_cast<double>(g.time_step));
@@ -144,7 +189,7 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
       sb.regions = solved.regions;
       ++sb.rounds;
       if (sb.last_move_m < o.soft_body_settled_m) break;
-      body_collider = make_body_collider(sb.body.mesh, o.collision);
+      body_collider = make_body_collider(sb.body.mesh, o.collision, collider_options);
       colliders[0] = body_collider.get();
       for (size_t i = 0; i < result.garments.size(); ++i) {
         DressedGarment& g = result.garments[i];

@@ -86,6 +86,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"max_strain", st.max},
                         {"p99_strain", st.p99},
                         {"coarse_start", coarse},
+                        {"start", g.transferred ? "transferred" : g.transfer_failed ? "placed_after_transfer" : "placed"},
                         {"sewing_iterations", g.sewing_iterations},
                         {"sewing_stalled", g.sewing_stalled},
                         {"pulled_closed_pairs", g.pulled_closed},

@@ -304,7 +304,9 @@ std::vector<PatternGirth> pattern_girths(const Body& body, const DressedGarment&
 
 std::vector<PatternSize> measure_pattern(const Body& body, const GarmentSpec& spec, const DressOptions& options) {
   std::vector<PatternSize> out;
-  const auto collider = make_body_collider(body.mesh, options.collision);
+  BodyColliderOptions few_queries;  // placement only: straight from the tree
+  few_queries.candidate_grid = false;
+  const auto collider = make_body_collider(body.mesh, options.collision, few_queries);
   for (const std::string& size : spec.sizes) {
     const Garment garment = garment_in_size(spec, size);
     const DressedGarment placed = prepare_garment(body, garment, *collider, options);

@@ -185,7 +185,9 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
   // Before draping: each size's pattern placed round the body and measured at the body's girth
   // lines and at its own.
   {
-    const auto placement_collider = make_body_collider(body.mesh, options.collision);
+    BodyColliderOptions few_queries;  // placement only: straight from the tree
+    few_queries.candidate_grid = false;
+    const auto placement_collider = make_body_collider(body.mesh, options.collision, few_queries);
     for (SizeTrial& t : advice.sizes) {
       const DressedGarment placed = prepare_garment(body, t.garment, *placement_collider, options);
       t.pattern = pattern_measurements(body, fit_garment(placed, t.garment));

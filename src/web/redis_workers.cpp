@@ -113,7 +113,7 @@ void RedisWorkers::work(const std::string& worker) {
               shown = p;
               redis->set_progress(job->tryon, std::min(p, 0.99), options_.keep);
             },
-            staged);
+            staged, &transfers_);
         result.done = true;
         result.size = outcome.size;
         result.report = outcome.report;

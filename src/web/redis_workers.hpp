@@ -28,6 +28,7 @@ class RedisWorkers {
 
   const ServeOptions& options_;
   const Catalogue& catalogue_;
+  GarmentTransferStore transfers_;  // garments dressed here before, to start the next from
   std::vector<std::string> ids_;
   std::vector<std::thread> threads_;
   std::thread heartbeat_;

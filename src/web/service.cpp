@@ -304,7 +304,7 @@ void TryOnService::dress_one(const std::string& id) {
   const std::filesystem::path staged = options_.data_dir / "work" / id;
   try {
     const TryOnOutcome outcome =
-        run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress, staged);
+        run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress, staged, &transfers_);
     finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged);
   } catch (const InputError& e) {
     // A garment file the catalogue took in every size still failed to mesh or place on this body.

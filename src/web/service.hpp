@@ -108,6 +108,9 @@ class TryOnService {
 
   ServeOptions options_;
   Catalogue& catalogue_;
+  // Garments dressed before on bodies from measurements: a try-on on another such body starts from
+  // the nearest one's (docs/web.md).
+  GarmentTransferStore transfers_;
   size_t workers_count_ = 1, capacity_ = 4;
   int omp_threads_per_worker_ = 1;
 

@@ -40,8 +40,18 @@ nlohmann::json legend_json(const Legend& legend) {
 }  // namespace
 
 TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std::string& size,
-                       const DressOptions& o, const std::function<void(double)>& set_progress,
-                       const std::filesystem::path& staged) {
+                       const DressOptions& options, const std::function<void(double)>& set_progress,
+                       const std::filesystem::path& staged, GarmentTransferStore* transfers) {
+  DressOptions o = options;
+  if (transfers)
+    for (const std::string& s : entry.spec.sizes)
+      if (size == "auto" || s == size)
+        for (auto& t : transfers->for_body(entry.spec.name, s, body)) o.transfers.push_back(std::move(t));
+  const auto keep = [&](const DressResult& r) {
+    if (transfers && r.passed())
+      for (const DressedGarment& g : r.garments)
+        transfers->add(std::make_shared<GarmentTransfer>(make_garment_transfer(body, g)));
+  };
   DressResult result;
   FitAnalysis fit;
   nlohmann::json report;
@@ -57,6 +67,7 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
       for (size_t i = 0; i < advice.sizes.size(); ++i)
         if (advice.sizes[i].size == advice.chart_size) shown = i;
     }
+    for (const SizeTrial& t : advice.sizes) keep(t.result);
     SizeTrial& trial = advice.sizes.at(shown);
     report = nlohmann::json::parse(report_with_fit(dress_report_json(body, trial.result, o), trial.fit));
     report["size_advice"] = nlohmann::json::parse(size_advice_json(body, advice));
@@ -72,6 +83,7 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
           p.phase_limit_seconds > 0 ? std::min(1.0, p.simulated_seconds / p.phase_limit_seconds) : 0.0;
       set_progress(0.5 * ((phase.ends_with("draping") ? 1.0 : 0.0) + frac));
     });
+    keep(result);
     const std::vector<Garment> made{garment_in_size(entry.spec, result.garments.at(0).size)};
     fit = analyse_dress_fit(body, result, made);
     report = nlohmann::json::parse(report_with_fit(dress_report_json(body, result, o), fit));

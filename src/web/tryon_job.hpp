@@ -20,10 +20,12 @@ struct TryOnOutcome {
 // Dresses `body` in the garment at `size` (a size of it, or "auto": every size dressed and one
 // recommended, docs/fit.md) and writes dressed.glb, fit.glb, preview.png and report.json into
 // `dir` (made empty first). `progress` receives 0..1. Throws InputError when the garment cannot be
-// dressed on this body, std::exception for anything else.
+// dressed on this body, std::exception for anything else. With `transfers`, each size starts from
+// the same garment dressed before on the nearest body of this body's mesh, where there is one
+// (drape/garment_transfer.hpp), and each size that passes its gates is kept there for the next.
 TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& garment, const std::string& size,
                        const DressOptions& options, const std::function<void(double)>& progress,
-                       const std::filesystem::path& dir);
+                       const std::filesystem::path& dir, GarmentTransferStore* transfers = nullptr);
 
 // The files a finished try-on has, in the order they are written.
 inline constexpr const char* kTryOnFiles[] = {"dressed.glb", "fit.glb", "preview.png", "report.json"};

@@ -13,6 +13,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wnull-dereference"
 #include <Eigen/CholmodSupport>
+#include <dlfcn.h>
 #include <omp.h>
 #include <Eigen/Sparse>
 #pragma GCC diagnostic pop
@@ -76,10 +77,24 @@ constexpr double kMaxDampingStep = 10.0;  // s: the weakest quasi-static damping
 constexpr double kArmijo = 1e-4;
 
 // CHOLMOD's supernodal factorisation and solves call the BLAS, and a BLAS built without locks
-// (Debian's libopenblas0-serial, which the system picks over the reference BLAS once installed)
-// returns wrong numbers when two threads call it at once, as two dressings on their own threads do
-// (`drape fit` dressing sizes side by side, the web service's workers). One lock for every solver
-// in the process serialises those calls; everything else in a step runs unlocked.
+// (Debian's libopenblas0-serial) returns wrong numbers when two threads call it at once, as two
+// dressings on their own threads do (`drape fit` dressing sizes side by side, the web service's
+// workers). OpenBLAS's pthread and OpenMP builds (libopenblas0-pthread, which `make deps` installs
+// and the system picks first) lock their buffers; told to use one thread (the dressings already
+// share the cores), they take calls from several threads at once, and so does the reference BLAS,
+// which keeps nothing between calls. Only a serial OpenBLAS is called under one lock for every
+// solver in the process. Asked once, through the symbols OpenBLAS exports, whatever BLAS the
+// system links in.
+bool blas_takes_concurrent_calls() {
+  static const bool concurrent = [] {
+    const auto parallel = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_parallel"));
+    if (!parallel) return true;
+    if (parallel() == 0) return false;
+    if (const auto set = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) set(1);
+    return true;
+  }();
+  return concurrent;
+}
 std::mutex& blas_lock() {
   static std::mutex lock;
   return lock;
@@ -89,19 +104,42 @@ std::mutex& blas_lock() {
 // inside the supernodal factorisation, one per large supernode: on two cores, their threads'
 // wake-ups and sleeps cost more than the factorisation's arithmetic (the shirt's 4188 unknowns: 38
 // ms a factorisation, a third of it in the kernel's futex calls). No setting of CHOLMOD's reaches
-// them, so while it runs (under the BLAS lock, one thread at a time) no OpenMP region may be
-// active: the process's other loops run on one thread meanwhile, which changes none of their results.
-// Every call into CHOLMOD holds one of these: the BLAS lock, then OpenMP made serial.
+// them, so while any solver is in CHOLMOD no OpenMP region may be active (OpenMP's active levels
+// are the process's, set to 0 by the first call in and restored by the last one out): the
+// process's other loops run on one thread meanwhile, which changes none of their results.
+// Every call into CHOLMOD holds one of these: the BLAS lock where the BLAS needs it, then OpenMP
+// made serial.
 class CholmodCall {
  public:
-  CholmodCall() : hold_(blas_lock()), levels_(omp_get_max_active_levels()) { omp_set_max_active_levels(0); }
-  ~CholmodCall() { omp_set_max_active_levels(levels_); }
+  CholmodCall() {
+    if (!blas_takes_concurrent_calls()) hold_ = std::unique_lock(blas_lock());
+    const std::lock_guard lock(levels_mutex());
+    if (inside()++ == 0) {
+      saved_levels() = omp_get_max_active_levels();
+      omp_set_max_active_levels(0);
+    }
+  }
+  ~CholmodCall() {
+    const std::lock_guard lock(levels_mutex());
+    if (--inside() == 0) omp_set_max_active_levels(saved_levels());
+  }
   CholmodCall(const CholmodCall&) = delete;
   CholmodCall& operator=(const CholmodCall&) = delete;
 
  private:
-  std::lock_guard<std::mutex> hold_;
-  int levels_;
+  static std::mutex& levels_mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static int& inside() {
+    static int n = 0;
+    return n;
+  }
+  static int& saved_levels() {
+    static int levels = 0;
+    return levels;
+  }
+  std::unique_lock<std::mutex> hold_;
 };
 
 double now() {

@@ -192,7 +192,9 @@ TEST(ImplicitSolver, ResultsDoNotDependOnTheThreadCount) {
 
 // Two solvers stepping at the same time on their own threads, as dressings side by side do (`drape
 // fit`, the web service's workers), give what each gives alone: the sparse factorisation's BLAS
-// calls, which a BLAS built without locks answers wrongly from two threads at once, are serialised.
+// calls run on both threads at once where the BLAS locks its buffers (OpenBLAS's pthread build,
+// the reference BLAS), and are serialised where it does not (a serial OpenBLAS, which answers
+// wrongly from two threads at once).
 TEST(ImplicitSolver, TwoSolversOnTwoThreadsGiveWhatEachGivesAlone) {
   const ClothModel m = hanging_cloth(40, true);
   ImplicitSettings settings = default_implicit_settings(m);

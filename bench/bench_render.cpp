@@ -4,6 +4,7 @@
 // benchmark runs without ../shared/data; with it, the MakeHuman body is measured too.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -63,6 +64,18 @@ void preview(benchmark::State& state, const Mesh& mesh) {
   state.counters["triangles"] = static_cast<double>(mesh.triangles.size());
 }
 
+// The preview picture (two rows of three views, as `drape dress` writes it) encoded as PNG.
+void BM_EncodePreviewPng(benchmark::State& state) {
+  static const Mesh mesh = standing_ellipsoid();
+  const drape::Image row = drape::render_views({drape::body_item(mesh)}, drape::RenderOptions{});
+  drape::Image both(row.width, 2 * row.height);
+  std::copy(row.rgb.begin(), row.rgb.end(), both.rgb.begin());
+  std::copy(row.rgb.begin(), row.rgb.end(), both.rgb.begin() + static_cast<std::ptrdiff_t>(row.rgb.size()));
+  size_t bytes = 0;
+  for (auto _ : state) bytes = drape::encode_png(both).size();
+  state.counters["bytes"] = static_cast<double>(bytes);
+}
+
 void BM_DepthNormalMaps_Ellipsoid50k(benchmark::State& state) {
   static const Mesh mesh = standing_ellipsoid();
   depth_normal_maps(state, mesh);
@@ -87,4 +100,5 @@ BENCHMARK(BM_DepthNormalMaps_Ellipsoid50k)->Arg(2)->Arg(5)->Unit(benchmark::kMil
 BENCHMARK(BM_DepthNormalMaps_Body)->Arg(2)->Arg(5)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Preview3Views_Ellipsoid50k)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Preview3Views_Body)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EncodePreviewPng)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -107,6 +107,9 @@ struct DressOptions {
   // (m) off the skin and the skin does not show through a coarse mesh (the default shirt's
   // shoulders). Not while sewing: lifted panels kept seams open. Negative: off.
   float face_clearance = 0.0f;
+  // Every garment's placement moved by this much (m) before sewing: a start a little off where
+  // placement puts it, as the robustness tests dress from (a garment must not depend on it).
+  Vec3f placement_offset = Vec3f::Zero();
   // Cap on iterations per garment over both phases (0: none). A run stopped by it is unsettled.
   uint64_t max_iterations = 0;
   // false: stop after placement (to inspect where the panels start); the run is not settled.
@@ -273,8 +276,23 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& garments,
 Scene dressed_scene(const Body& body, const DressResult& result);
 // report.json text: DESIGN.md's keys, gates, per-garment details and the stage profile.
 std::string dress_report_json(const Body& body, const DressResult& result, const DressOptions& options);
-// Writes dressed.glb, preview.png and report.json into `dir`, each atomically.
+// What preview.png draws, copied out of a dressing so that it can be drawn later (the web service
+// draws it once the shopper has the dressed body): the body and the garments as dressed, and each
+// garment particle's structural strain.
+struct DressPreview {
+  Mesh body;
+  std::vector<Mesh> garments;
+  std::vector<std::vector<float>> strain;  // per garment, per particle
+  float strain_threshold = 0.05f;          // the strain row's scale ends 1 % above it
+};
+DressPreview dress_preview(const Body& body, const DressResult& result);
+// preview.png: front, side and back; a second row coloured by structural strain.
+std::vector<uint8_t> encode_preview_png(const DressPreview& preview);
+
+enum class PreviewOutput : uint8_t { Write, Leave };
+// Writes dressed.glb, preview.png (unless left for later) and report.json into `dir`, each
+// atomically.
 void write_dress_outputs(const std::filesystem::path& dir, const Body& body, const DressResult& result,
-                         const DressOptions& options);
+                         const DressOptions& options, PreviewOutput preview = PreviewOutput::Write);
 
 }  // namespace drape

@@ -22,6 +22,7 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   dressing::gather_elastic_bands(body, garment, mesh, placed, cloth);
   g.model = compile(std::move(cloth.spec));
   g.state = initial_state(g.model);
+  for (Vec3f& x : g.state.x) x += o.placement_offset;
   g.seam_pairs = std::move(cloth.seam_pairs);
   g.seam_of_pair = std::move(cloth.seam_of_pair);
   for (const SeamSpec& s : garment.seams) g.seam_names.push_back(s.name);

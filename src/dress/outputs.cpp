@@ -156,45 +156,51 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
   return report_json(r.quality, r.simulation, r.gates, extra.dump());
 }
 
-void write_dress_outputs(const std::filesystem::path& dir, const Body& given, const DressResult& result,
-                         const DressOptions& options) {
+DressPreview dress_preview(const Body& given, const DressResult& result) {
   // A soft body is drawn as the garments left it.
-  const Body& body = result.soft_body ? result.soft_body->body : given;
-  // Everything is encoded first, then written, so a failure while encoding leaves nothing behind.
-  const std::vector<unsigned char> glb = encode_glb(dressed_scene(body, result));
+  DressPreview p;
+  p.body = result.soft_body ? result.soft_body->body.mesh : given.mesh;
+  for (const DressedGarment& g : result.garments) {
+    p.garments.push_back(g.mesh());
+    p.strain.push_back(particle_strain(g.model, g.state.x));
+    p.strain_threshold = g.model.fabric.strain_threshold;
+  }
+  return p;
+}
 
-  std::vector<Mesh> meshes;
-  for (const DressedGarment& g : result.garments) meshes.push_back(g.mesh());
+std::vector<uint8_t> encode_preview_png(const DressPreview& p) {
   RenderOptions ro;
   ro.width = 1200;
   ro.height = 600;
-  std::vector<RenderItem> items{body_item(body.mesh)};
-  for (size_t i = 0; i < meshes.size(); ++i) items.push_back(garment_item(meshes[i], i));
+  std::vector<RenderItem> items{body_item(p.body)};
+  for (size_t i = 0; i < p.garments.size(); ++i) items.push_back(garment_item(p.garments[i], i));
   const Image shaded = render_views(items, ro);
   // Second row: structural strain (0 .. threshold + 1 %) on the same views.
-  float threshold = 0.05f;
-  std::vector<RenderItem> strain_items{body_item(body.mesh)};
-  for (size_t i = 0; i < meshes.size(); ++i) {
-    const DressedGarment& g = result.garments[i];
-    threshold = g.model.fabric.strain_threshold;
-    const std::vector<float> s = particle_strain(g.model, g.state.x);
-    RenderItem it = garment_item(meshes[i], i);
-    it.vertex_colors = colorize(s, ColorMap::kViridis, 0.0f, threshold + 0.01f);
-    strain_items.push_back(std::move(it));
-  }
+  const float hi = p.strain_threshold + 0.01f;
+  for (size_t i = 0; i < p.garments.size(); ++i) items[i + 1].vertex_colors = colorize(p.strain[i], ColorMap::kViridis, 0.0f, hi);
   RenderOptions so = ro;
-  so.legend = Legend{"strain", ColorMap::kViridis, 0.0f, threshold + 0.01f};
-  const Image strain = render_views(strain_items, so);
+  so.legend = Legend{"strain", ColorMap::kViridis, 0.0f, hi};
+  const Image strain = render_views(items, so);
   Image both(shaded.width, shaded.height + strain.height);
   for (int y = 0; y < shaded.height; ++y)
     std::copy_n(shaded.pixel(0, y), 3 * static_cast<size_t>(shaded.width), both.pixel(0, y));
   for (int y = 0; y < strain.height; ++y)
     std::copy_n(strain.pixel(0, y), 3 * static_cast<size_t>(std::min(strain.width, both.width)), both.pixel(0, shaded.height + y));
-  const std::vector<uint8_t> png = encode_png(both);
+  return encode_png(both);
+}
+
+void write_dress_outputs(const std::filesystem::path& dir, const Body& given, const DressResult& result,
+                         const DressOptions& options, PreviewOutput preview) {
+  // A soft body is drawn as the garments left it.
+  const Body& body = result.soft_body ? result.soft_body->body : given;
+  // Everything is encoded first, then written, so a failure while encoding leaves nothing behind.
+  const std::vector<unsigned char> glb = encode_glb(dressed_scene(body, result));
+  const std::vector<uint8_t> png =
+      preview == PreviewOutput::Write ? encode_preview_png(dress_preview(given, result)) : std::vector<uint8_t>{};
   const std::string report = dress_report_json(given, result, options);
 
   write_file_atomic(dir / "dressed.glb", glb);
-  write_file_atomic(dir / "preview.png", png);
+  if (preview == PreviewOutput::Write) write_file_atomic(dir / "preview.png", png);
   write_file_atomic(dir / "report.json", report);
 }
 

@@ -24,6 +24,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Previews waiting to be drawn, at most: beyond it a worker draws one before its next try-on, so a
+// shop that is never idle holds a bounded number of dressed scenes in memory.
+constexpr size_t kMaxPendingPreviews = 8;
+
 }  // namespace
 
 void remove_inside(const std::filesystem::path& root, const std::filesystem::path& target) {
@@ -177,6 +181,7 @@ void TryOnService::remove_body_locked(const std::string& id_in) {
     if (redis_ && !tr->second.job.empty()) redis_try([&] { redis_->remove(tr->second.job); });
     tryons_.erase(tr);
     queue_.erase(std::remove(queue_.begin(), queue_.end(), t), queue_.end());
+    previews_.erase(t);  // a worker drawing it meanwhile finds the try-on gone and writes nothing
   }
   if (redis_) redis_try([&] { redis_->delete_body(id); });
   bodies_.erase(it);
@@ -232,14 +237,43 @@ std::optional<TryOnView> TryOnService::tryon(const std::string& id) const {
   return it->second.view;
 }
 
-std::optional<std::filesystem::path> TryOnService::tryon_file(const std::string& id,
-                                                              const std::string& name) const {
+std::optional<std::filesystem::path> TryOnService::tryon_file(const std::string& id, const std::string& name) {
   if (name != "dressed.glb" && name != "fit.glb" && name != "preview.png" && name != "report.json")
     return std::nullopt;
+  std::shared_ptr<PendingPreview> pending;
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = tryons_.find(id);
+    if (it == tryons_.end() || it->second.view.state != TryOnState::Done) return std::nullopt;
+    if (const auto p = previews_.find(id); name == "preview.png" && p != previews_.end()) pending = p->second;
+  }
+  if (pending) draw_preview(id, pending);
   std::lock_guard lock(mutex_);
-  const auto it = tryons_.find(id);
-  if (it == tryons_.end() || it->second.view.state != TryOnState::Done) return std::nullopt;
+  const auto it = tryons_.find(id);  // again: it may have been deleted while its preview was drawn
+  if (it == tryons_.end()) return std::nullopt;
   return body_dir(it->second.view.body) / "tryons" / id / name;
+}
+
+void TryOnService::draw_preview(const std::string& id, const std::shared_ptr<PendingPreview>& preview) {
+  const std::lock_guard drawing(preview->drawing);
+  if (preview->drawn) return;
+  std::vector<uint8_t> png;
+  try {
+    png = encode_preview_png(preview->scene);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drape serve: a try-on's preview could not be drawn: %s\n", e.what());
+  }
+  std::lock_guard lock(mutex_);
+  preview->drawn = true;
+  preview->scene = DressPreview{};
+  if (const auto p = previews_.find(id); p != previews_.end() && p->second == preview) previews_.erase(p);
+  const auto it = tryons_.find(id);
+  if (it == tryons_.end() || png.empty()) return;  // deleted or expired meanwhile: nothing of it may stay
+  try {
+    write_file_atomic(body_dir(it->second.view.body) / "tryons" / id / "preview.png", png);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "drape serve: a try-on's preview could not be kept: %s\n", e.what());
+  }
 }
 
 ServiceStats TryOnService::stats() const {
@@ -268,13 +302,26 @@ void TryOnService::worker_loop() {
   omp_set_num_threads(omp_threads_per_worker_);
   for (;;) {
     std::string id;
+    std::shared_ptr<PendingPreview> preview;
     {
       std::unique_lock lock(mutex_);
-      queue_cv_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      queue_cv_.wait(lock, [&] { return stopping_ || !queue_.empty() || !preview_queue_.empty(); });
       if (stopping_) return;
-      id = queue_.front();
-      queue_.pop_front();
-      ++running_;
+      if (queue_.empty() || preview_queue_.size() > kMaxPendingPreviews) {
+        id = preview_queue_.front();
+        preview_queue_.pop_front();
+        const auto p = previews_.find(id);
+        if (p == previews_.end()) continue;  // drawn when asked for, or its body deleted
+        preview = p->second;
+      } else {
+        id = queue_.front();
+        queue_.pop_front();
+        ++running_;
+      }
+    }
+    if (preview) {
+      draw_preview(id, preview);
+      continue;
     }
     const auto start = Clock::now();
     dress_one(id);
@@ -303,9 +350,9 @@ void TryOnService::dress_one(const std::string& id) {
   };
   const std::filesystem::path staged = options_.data_dir / "work" / id;
   try {
-    const TryOnOutcome outcome =
-        run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress, staged, &transfers_);
-    finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged);
+    TryOnOutcome outcome = run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress,
+                                     staged, &transfers_, PreviewOutput::Leave);
+    finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged, std::move(outcome.preview));
   } catch (const InputError& e) {
     // A garment file the catalogue took in every size still failed to mesh or place on this body.
     finish(id, TryOnState::Failed, {},
@@ -319,7 +366,7 @@ void TryOnService::dress_one(const std::string& id) {
 
 void TryOnService::finish(const std::string& id, TryOnState state, const std::string& size,
                           const std::string& error, nlohmann::json report,
-                          const std::filesystem::path& staged) {
+                          const std::filesystem::path& staged, std::optional<DressPreview> preview) {
   std::error_code ec;
   std::lock_guard lock(mutex_);
   const auto it = tryons_.find(id);
@@ -348,6 +395,13 @@ void TryOnService::finish(const std::string& id, TryOnState state, const std::st
     view.size = size;
     view.report = std::move(report);
     ++done_;
+    if (preview) {
+      auto pending = std::make_shared<PendingPreview>();
+      pending->scene = std::move(*preview);
+      previews_[id] = std::move(pending);
+      preview_queue_.push_back(id);
+      queue_cv_.notify_one();
+    }
   } else {
     view.error = error.empty() ? "the try-on's results could not be kept on the server" : error;
     // A failed try-on is not the cached answer: asking again tries again.

@@ -74,8 +74,9 @@ class TryOnService {
   // RequestError 404 (unknown body), 400 (unknown garment or size), 503 (queue full).
   Submitted submit(const std::string& body_id, const std::string& garment, const std::string& size);
   std::optional<TryOnView> tryon(const std::string& id) const;
-  // A finished try-on's file: dressed.glb, fit.glb, preview.png or report.json.
-  std::optional<std::filesystem::path> tryon_file(const std::string& id, const std::string& name) const;
+  // A finished try-on's file: dressed.glb, fit.glb, preview.png or report.json. A preview not drawn
+  // yet is drawn now.
+  std::optional<std::filesystem::path> tryon_file(const std::string& id, const std::string& name);
 
   ServiceStats stats() const;
   // Seconds a shopper turned away by a full queue should wait: the queue's length times the
@@ -103,7 +104,17 @@ class TryOnService {
   void dress_one(const std::string& tryon_id);
   void remove_body_locked(const std::string& id);
   void finish(const std::string& tryon_id, TryOnState state, const std::string& size,
-              const std::string& error, nlohmann::json report, const std::filesystem::path& staged);
+              const std::string& error, nlohmann::json report, const std::filesystem::path& staged,
+              std::optional<DressPreview> preview = std::nullopt);
+  // preview.png of a try-on done by this process's workers: the shopper is answered once the
+  // dressed body is written, and the picture (a third of a warmed try-on's work) is drawn by a
+  // worker when no try-on waits, or at once when it is asked for, whichever comes first.
+  struct PendingPreview {
+    std::mutex drawing;  // taken before mutex_, never while holding it
+    bool drawn = false;
+    DressPreview scene;
+  };
+  void draw_preview(const std::string& tryon_id, const std::shared_ptr<PendingPreview>& preview);
   std::filesystem::path body_dir(const std::string& id) const;
 
   ServeOptions options_;
@@ -121,6 +132,8 @@ class TryOnService {
   std::map<std::string, TryOnRecord> tryons_;
   std::map<std::string, std::string> cache_;  // body + garment + size -> try-on id
   std::deque<std::string> queue_;
+  std::map<std::string, std::shared_ptr<PendingPreview>> previews_;  // try-on id -> its preview to draw
+  std::deque<std::string> preview_queue_;                            // in the order they were done
   size_t running_ = 0, done_ = 0, failed_ = 0, rejected_ = 0;
   double dress_seconds_total_ = 0;
   std::vector<std::thread> workers_;

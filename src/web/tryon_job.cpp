@@ -41,7 +41,8 @@ nlohmann::json legend_json(const Legend& legend) {
 
 TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std::string& size,
                        const DressOptions& options, const std::function<void(double)>& set_progress,
-                       const std::filesystem::path& staged, GarmentTransferStore* transfers) {
+                       const std::filesystem::path& staged, GarmentTransferStore* transfers,
+                       PreviewOutput preview) {
   DressOptions o = options;
   if (transfers)
     for (const std::string& s : entry.spec.sizes)
@@ -92,10 +93,12 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
   report["legends"] = {{"garment", legend_json(strain_legend())},
                        {"body", legend_json(pressure_legend(fit))}};
   std::filesystem::remove_all(staged);
-  write_dress_outputs(staged, body, result, o);
+  write_dress_outputs(staged, body, result, o, preview);
   write_file_atomic(staged / "report.json", report.dump(2));
   write_scene(staged / "fit.glb", fit_scene(body, result, fit));
-  return {result.garments.at(0).size, shopper_report(report)};
+  TryOnOutcome outcome{result.garments.at(0).size, shopper_report(report), std::nullopt};
+  if (preview == PreviewOutput::Leave) outcome.preview = dress_preview(body, result);
+  return outcome;
 }
 
 }  // namespace drape::web

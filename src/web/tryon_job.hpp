@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "drape/body.hpp"
@@ -15,17 +16,20 @@ namespace drape::web {
 struct TryOnOutcome {
   std::string size;       // the size dressed (for "auto", the recommended one)
   nlohmann::json report;  // what the page shows: passed, quality, gates, fit, size_advice, legends
+  std::optional<DressPreview> preview;  // preview.png's scene, when it was left to be drawn later
 };
 
 // Dresses `body` in the garment at `size` (a size of it, or "auto": every size dressed and one
 // recommended, docs/fit.md) and writes dressed.glb, fit.glb, preview.png and report.json into
-// `dir` (made empty first). `progress` receives 0..1. Throws InputError when the garment cannot be
+// `dir` (made empty first); with PreviewOutput::Leave, preview.png is not drawn and the outcome
+// holds its scene instead (encode_preview_png). `progress` receives 0..1. Throws InputError when the garment cannot be
 // dressed on this body, std::exception for anything else. With `transfers`, each size starts from
 // the same garment dressed before on the nearest body of this body's mesh, where there is one
 // (drape/garment_transfer.hpp), and each size that passes its gates is kept there for the next.
 TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& garment, const std::string& size,
                        const DressOptions& options, const std::function<void(double)>& progress,
-                       const std::filesystem::path& dir, GarmentTransferStore* transfers = nullptr);
+                       const std::filesystem::path& dir, GarmentTransferStore* transfers = nullptr,
+                       PreviewOutput preview = PreviewOutput::Write);
 
 // The files a finished try-on has, in the order they are written.
 inline constexpr const char* kTryOnFiles[] = {"dressed.glb", "fit.glb", "preview.png", "report.json"};

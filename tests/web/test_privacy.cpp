@@ -113,6 +113,37 @@ TEST(WebPrivacy, DeletedWhileDressingLeavesNothingBehind) {
   EXPECT_TRUE(files_naming(server.options.data_dir, tryon).empty());
 }
 
+// A try-on is answered once its dressed body is written; its preview.png is drawn when the worker
+// has no try-on waiting. A body deleted before that leaves no preview behind, and the next try-on's
+// preview is drawn without anyone asking for it.
+TEST(WebPrivacy, PreviewsAreDrawnWhenIdleAndNotForADeletedBody) {
+  TestServer server(quick_serve_options("web_privacy_preview"));
+  auto c = server.client();
+  const std::string first = json_of(c.Post("/api/bodies", R"({"sex": "female"})", "application/json"))["id"];
+  const std::string second = json_of(c.Post("/api/bodies", R"({"sex": "male"})", "application/json"))["id"];
+  const auto a = c.Post("/api/tryons", json{{"body", first}, {"garment", "skirt"}, {"size", "M"}}.dump(),
+                        "application/json");
+  const auto b = c.Post("/api/tryons", json{{"body", second}, {"garment", "skirt"}, {"size", "L"}}.dump(),
+                        "application/json");
+  ASSERT_TRUE(a && b);
+  const std::string tryon_a = json_of(a)["id"], tryon_b = json_of(b)["id"];
+  ASSERT_EQ(wait_for_tryon(c, tryon_a)["state"], "done");
+  // The one worker went on to the second try-on before drawing the first's preview.
+  ASSERT_EQ(c.Delete("/api/bodies/" + first)->status, 204);
+  ASSERT_EQ(wait_for_tryon(c, tryon_b)["state"], "done");
+  const std::filesystem::path preview =
+      server.options.data_dir / "bodies" / second / "tryons" / tryon_b / "preview.png";
+  for (int i = 0; i < 3000 && !std::filesystem::exists(preview); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(std::filesystem::exists(preview));
+  EXPECT_TRUE(files_naming(server.options.data_dir, first).empty());
+  EXPECT_TRUE(files_naming(server.options.data_dir, tryon_a).empty());
+  const auto png = c.Get("/api/tryons/" + tryon_b + "/preview.png");
+  ASSERT_TRUE(png);
+  EXPECT_EQ(png->status, 200);
+  EXPECT_EQ(png->body.substr(1, 3), "PNG");
+}
+
 TEST(WebPrivacy, StoppingRemovesTheBodiesItHeldAndNothingElse) {
   ServeOptions o = quick_serve_options("web_privacy_stop");
   // Beside the data folder and inside it: files the server must leave alone.

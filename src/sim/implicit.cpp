@@ -36,9 +36,13 @@ using Mat3d = Eigen::Matrix3d;
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 // The strain limit's barrier is this many times stiffer than the spring it limits: a structural
-// spring pulled by ten times the force that stretches it to the threshold s goes past it by 0.03 s
-// (0.15 % at s = 5 %), within the gates' 1 % tolerance, also where a waistband carries a garment.
-constexpr double kLimitStiffness = 300.0;
+// spring pulled by ten times the force that stretches it to the threshold s goes past it by 0.009 s
+// (0.045 % at s = 5 %), within the gates' 1 % tolerance, also where a waistband carries a garment
+// or the body presses a size too small outwards. At 300x, garments pressed out by the body rested
+// 1.0-1.3 % over the threshold (the trousers L and M on the default male body 6.04 and 6.60 %, one
+// robustness start of the skirt L on him 6.25 %, of the trousers XL 6.08 %). Newton iterations at
+// 1000x: README's five garments 982 against 997, five more 1216 against 1170 (docs/cloth.md).
+constexpr double kLimitStiffness = 1000.0;
 // Contact penalty per square metre of cloth a particle represents (N/m per m^2): a pressure of
 // 100 Pa per millimetre inside the thickness layer. Hanging cloth presses with its weight, ~1.5 Pa;
 // a garment at its strain limit round a 5 cm limb with ~200 Pa: both stay within the layer.

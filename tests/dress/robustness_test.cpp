@@ -3,9 +3,8 @@
 // the whole placement moved up to 1 cm in a random direction. A single failure fails the case.
 // Two starts per case here; ten with --gtest_also_run_disabled_tests
 // (`build/tests/test_dress --gtest_also_run_disabled_tests --gtest_filter='*PerturbedStart*'`),
-// where one start of the skirt L on the male body still ends over its strain gate, and on the
-// shared bodies three of the jeans M on the average man with their band's edge in his skin
-// (docs/dressing.md, "Status").
+// where on the shared bodies three starts of the jeans M on the average man end with their band's
+// edge in his skin and one of the shirt XL on him does not settle (docs/dressing.md, "Status").
 #include <gtest/gtest.h>
 
 #include <cmath>

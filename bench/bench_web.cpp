@@ -1,6 +1,6 @@
 // The web try-on's latency: from POST /api/tryons to the dressed body in the shopper's page (it
-// polls every 20 ms and fetches dressed.glb once the try-on is done), with 1 and 4 shoppers at once on loopback against a server with
-// one worker per core. Each try-on is a fresh body from measurements (made before the clock starts;
+// polls every 20 ms and fetches dressed.glb once the try-on is done), with 1 and 4 shoppers at once
+// on loopback against a server with one worker per core. Each try-on is a fresh body from measurements (made before the clock starts;
 // heights 1.62-1.68 m, busts 0.90-0.94 m, each shopper's different) in the default shirt, size M,
 // at drape's default resolution, so none is answered from the cache. The third argument 1: the shop
 // has dressed the shirt M once before the shoppers come (an untimed try-on on the default body),

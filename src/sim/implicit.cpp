@@ -117,32 +117,22 @@ class CholmodCall {
  public:
   CholmodCall() {
     if (!blas_takes_concurrent_calls()) hold_ = std::unique_lock(blas_lock());
-    const std::lock_guard lock(levels_mutex());
-    if (inside()++ == 0) {
-      saved_levels() = omp_get_max_active_levels();
+    const std::lock_guard lock(levels_mutex_);
+    if (inside_++ == 0) {
+      saved_levels_ = omp_get_max_active_levels();
       omp_set_max_active_levels(0);
     }
   }
   ~CholmodCall() {
-    const std::lock_guard lock(levels_mutex());
-    if (--inside() == 0) omp_set_max_active_levels(saved_levels());
+    const std::lock_guard lock(levels_mutex_);
+    if (--inside_ == 0) omp_set_max_active_levels(saved_levels_);
   }
   CholmodCall(const CholmodCall&) = delete;
   CholmodCall& operator=(const CholmodCall&) = delete;
 
  private:
-  static std::mutex& levels_mutex() {
-    static std::mutex m;
-    return m;
-  }
-  static int& inside() {
-    static int n = 0;
-    return n;
-  }
-  static int& saved_levels() {
-    static int levels = 0;
-    return levels;
-  }
+  static inline std::mutex levels_mutex_;
+  static inline int inside_ = 0, saved_levels_ = 0;  // calls in CHOLMOD now; the levels before the first
   std::unique_lock<std::mutex> hold_;
 };
 

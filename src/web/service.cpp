@@ -307,7 +307,7 @@ void TryOnService::worker_loop() {
       std::unique_lock lock(mutex_);
       queue_cv_.wait(lock, [&] { return stopping_ || !queue_.empty() || !preview_queue_.empty(); });
       if (stopping_) return;
-      if (queue_.empty() || preview_queue_.size() > kMaxPendingPreviews) {
+      if (!preview_queue_.empty() && (queue_.empty() || previews_.size() > kMaxPendingPreviews)) {
         id = preview_queue_.front();
         preview_queue_.pop_front();
         const auto p = previews_.find(id);

@@ -176,6 +176,9 @@ struct ClothState {
   double time = 0;       // simulated seconds
   uint64_t iterations = 0;
   StepStatus status = StepStatus::Ok;
+  // The implicit solver's static friction, carried from step to step: each particle's tangential
+  // slip from where friction holds it (m, at most the slip at which it slides; empty: none).
+  std::vector<Vec3f> friction_slip;
   // Measured at the end of the last step.
   float max_speed = 0;        // m/s
   double kinetic_energy = 0;  // J

@@ -43,6 +43,8 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 // robustness start of the skirt L on him 6.25 %, of the trousers XL 6.08 %). Newton iterations at
 // 1000x: README's five garments 982 against 997, five more 1216 against 1170 (docs/cloth.md).
 constexpr double kLimitStiffness = 1000.0;
+// The barrier reaches its stiffness over this much strain, centred on the threshold (add_barrier).
+constexpr double kLimitOnset = 0.01;
 // Contact penalty per square metre of cloth a particle represents (N/m per m^2): a pressure of
 // 100 Pa per millimetre inside the thickness layer. Hanging cloth presses with its weight, ~1.5 Pa;
 // a garment at its strain limit round a 5 cm limb with ~200 Pa: both stay within the layer.
@@ -57,8 +59,12 @@ inline double contact_energy(double k, double d) {
 }
 inline double contact_force(double k, double d) { return d > 0 ? k * d * (1.0 + 0.5 * d / kContactStiffening) : 0.0; }
 inline double contact_stiffness(double k, double d) { return d > 0 ? k * (1.0 + d / kContactStiffening) : 0.0; }
-// Friction's smoothing (IPC): tangential slip below this per step is resisted like a stiff spring
-// (static friction), above it by the full Coulomb force.
+// Friction's smoothing (IPC): tangential slip below this is resisted like a stiff spring (static
+// friction), above it by the full Coulomb force. The slip is measured from where friction holds the
+// particle, which is carried from step to step (ClothState::friction_slip): a step's end that
+// friction holds stays held at the next step's start. Measured from each step's start instead,
+// every step began with the static friction of the last one let go, off balance by up to mu N
+// (at rest on the body: 20x a particle's weight), and spent iterations finding it again.
 constexpr double kFrictionSlip = 1e-4;  // m
 // A contact plane is found anew once its particle moved this far from where it was found.
 constexpr double kReplane = 1e-3;  // m
@@ -179,6 +185,34 @@ inline void add_spring(SpringTerm& t, const Vec3d& d, double l, double rest, dou
   t.hessian += k * (transverse * Mat3d::Identity() + (1.0 - transverse) * u * u.transpose());
 }
 
+// The strain limit's barrier on a spring of length l from `start`: k/2 (l - start)^2 once past
+// start + onset, reached smoothly over the onset (k e^3 / (6 onset), e = l - start), so that its
+// energy is twice differentiable. Started half the onset before the threshold, its force past the
+// onset is k (l - threshold), the force of a barrier starting at the threshold. (With the stiffness
+// stepping from 0 to 1000x the spring's at the threshold, Newton's quadratic model was wrong for
+// every spring an iteration took across it, and line searches cut the steps over many of them.)
+inline void add_barrier(SpringTerm& t, const Vec3d& d, double l, double start, double k, double onset) {
+  const double e = l - start;
+  if (e <= 0 || l < 1e-12) return;
+  double energy, force, stiffness;
+  if (e < onset) {
+    energy = k * e * e * e / (6.0 * onset);
+    force = k * e * e / (2.0 * onset);
+    stiffness = k * e / onset;
+  } else {
+    const double past = e - onset;
+    energy = k * (onset * onset / 6.0 + 0.5 * onset * past + 0.5 * past * past);
+    force = k * (e - 0.5 * onset);
+    stiffness = k;
+  }
+  const Vec3d u = d / l;
+  t.energy += energy;
+  t.gradient_b += force * u;
+  // Along the spring its stiffness, across it the tension over the length (both >= 0).
+  const double transverse = force / l;
+  t.hessian += transverse * Mat3d::Identity() + (stiffness - transverse) * u * u.transpose();
+}
+
 // Zero-length seam: k/2 l^2 up to the length where it pulls with `cap`, then a constant pull of
 // `cap` (its Hessian: the zero-length spring that pulls with `cap` at this length).
 inline void add_seam(SpringTerm& t, const Vec3d& d, double l, double k, double cap) {
@@ -239,6 +273,7 @@ struct ImplicitSolver::Impl {
   std::vector<uint8_t> in_range;          // a surface within the query radius
   std::vector<double> friction_force;     // per particle: lagged normal force x mu (N)
   std::vector<Vec3d> surface_velocity;
+  std::vector<Vec3d> held_slip;           // per particle: the slip friction held at the step's start
   std::vector<SpringTerm> spring_term;
   Eigen::VectorXd gradient, direction;
   std::vector<double> block_sum;
@@ -299,6 +334,7 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
   in_range.assign(n, 0);
   friction_force.assign(n, 0.0);
   surface_velocity.assign(n, Vec3d::Zero());
+  held_slip.assign(n, Vec3d::Zero());
   spring_term.resize(m.spring_count());
   bend_diag.assign(n, 0.0);
   bend_gradient.assign(n, Vec3d::Zero());
@@ -478,7 +514,7 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       const double pen = depth(i, at[i]);
       if (pen > 0) e += contact_energy(contact_k[i], pen);
       if (friction_force[i] > 0) {
-        Vec3d u = at[i] - x0[i] - surface_velocity[i];
+        Vec3d u = at[i] - x0[i] - surface_velocity[i] + held_slip[i];
         u -= plane_normal[i].dot(u) * plane_normal[i];
         const double slip = u.norm();
         e += friction_force[i] * (slip < kFrictionSlip ? 0.5 * slip * slip / kFrictionSlip : slip - 0.5 * kFrictionSlip);
@@ -534,8 +570,8 @@ void ImplicitSolver::Impl::spring_terms(const std::vector<Vec3d>& at, const Impl
       }
       const double rest = m.rest_length[k], stiff = m.stiffness[k];
       add_spring(t, d, l, rest, stiff, exact);
-      if (k >= structural.begin && k < structural.end && l > limit * rest)
-        add_spring(t, d, l, limit * rest, kLimitStiffness * stiff, exact);
+      if (k >= structural.begin && k < structural.end && l > (limit - 0.5 * kLimitOnset) * rest)
+        add_barrier(t, d, l, (limit - 0.5 * kLimitOnset) * rest, kLimitStiffness * stiff, kLimitOnset * rest);
     }
   });
 }
@@ -578,7 +614,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
           }
           if (friction_force[i] > 0) {
             const Mat3d tangent = Mat3d::Identity() - nrm * nrm.transpose();
-            const Vec3d u = tangent * (x[i] - x0[i] - surface_velocity[i]);
+            const Vec3d u = tangent * (x[i] - x0[i] - surface_velocity[i] + held_slip[i]);
             const double slip = u.norm();
             const double scale = slip < kFrictionSlip ? friction_force[i] / kFrictionSlip : friction_force[i] / slip;
             grad += scale * u;
@@ -699,6 +735,8 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   const uint64_t solves_before = w.triangular_solves;
   for (Collider* c : colliders) c->update(state.time + h);
   // Start: x0 = x_n; the inertial target y = x_n + h v_n (at rest: x_n); pinned particles follow y.
+  // Newton starts at x_n, where the contacts are found: started at y, cloth falling onto a sphere
+  // at 1/30 s began its steps up to 10 cm into it, and was pushed through.
   for (size_t i = 0; i < w.n; ++i) {
     w.x0[i] = state.x[i].cast<double>();
     w.y[i] = s.quasi_static ? w.x0[i] : Vec3d(w.x0[i] + h * state.v[i].cast<double>());
@@ -719,6 +757,8 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   w.detect_contacts(colliders, s, h, !w.planes_valid || s.moving_colliders);
   w.planes_valid = true;
   w.lag_friction(s);
+  const bool held = state.friction_slip.size() == w.n;
+  for (size_t i = 0; i < w.n; ++i) w.held_slip[i] = held ? Vec3d(state.friction_slip[i].cast<double>()) : Vec3d::Zero();
   // Quasi-static: the inertia term becomes a Levenberg-Marquardt damping m_i / (2 h_d^2) |x - x_k|^2
   // around the current iterate x_k (no force at x_k, so the fixed point is the state of rest), with
   // h_d growing while full Newton steps are taken and shrinking when the line search halves.
@@ -816,7 +856,20 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
       break;
     }
   }
-  // The state: positions, and velocities from the step (quasi-static: at rest).
+  // The state: positions, velocities from the step (quasi-static: at rest), and the slip friction
+  // holds (where it slides, the slip at which it does: the anchor follows the particle).
+  state.friction_slip.resize(w.n);
+  for (size_t i = 0; i < w.n; ++i) {
+    Vec3d u = Vec3d::Zero();
+    if (w.in_range[i] && w.friction_force[i] > 0) {
+      const Vec3d& nrm = w.plane_normal[i];
+      u = w.x[i] - w.x0[i] - w.surface_velocity[i] + w.held_slip[i];
+      u -= nrm.dot(u) * nrm;
+      const double slip = u.norm();
+      if (slip > kFrictionSlip) u *= kFrictionSlip / slip;
+    }
+    state.friction_slip[i] = u.cast<float>();
+  }
   float moved2 = 0;
   double kinetic = 0;
   float speed2 = 0;

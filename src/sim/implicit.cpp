@@ -43,8 +43,6 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 // robustness start of the skirt L on him 6.25 %, of the trousers XL 6.08 %). Newton iterations at
 // 1000x: README's five garments 982 against 997, five more 1216 against 1170 (docs/cloth.md).
 constexpr double kLimitStiffness = 1000.0;
-// The barrier reaches its stiffness over this much strain, centred on the threshold (add_barrier).
-constexpr double kLimitOnset = 0.01;
 // Contact penalty per square metre of cloth a particle represents (N/m per m^2): a pressure of
 // 100 Pa per millimetre inside the thickness layer. Hanging cloth presses with its weight, ~1.5 Pa;
 // a garment at its strain limit round a 5 cm limb with ~200 Pa: both stay within the layer.
@@ -183,34 +181,6 @@ inline void add_spring(SpringTerm& t, const Vec3d& d, double l, double rest, dou
   t.gradient_b += k * (l - rest) * u;
   const double transverse = exact ? 1.0 - rest / l : std::max(0.0, 1.0 - rest / l);
   t.hessian += k * (transverse * Mat3d::Identity() + (1.0 - transverse) * u * u.transpose());
-}
-
-// The strain limit's barrier on a spring of length l from `start`: k/2 (l - start)^2 once past
-// start + onset, reached smoothly over the onset (k e^3 / (6 onset), e = l - start), so that its
-// energy is twice differentiable. Started half the onset before the threshold, its force past the
-// onset is k (l - threshold), the force of a barrier starting at the threshold. (With the stiffness
-// stepping from 0 to 1000x the spring's at the threshold, Newton's quadratic model was wrong for
-// every spring an iteration took across it, and line searches cut the steps over many of them.)
-inline void add_barrier(SpringTerm& t, const Vec3d& d, double l, double start, double k, double onset) {
-  const double e = l - start;
-  if (e <= 0 || l < 1e-12) return;
-  double energy, force, stiffness;
-  if (e < onset) {
-    energy = k * e * e * e / (6.0 * onset);
-    force = k * e * e / (2.0 * onset);
-    stiffness = k * e / onset;
-  } else {
-    const double past = e - onset;
-    energy = k * (onset * onset / 6.0 + 0.5 * onset * past + 0.5 * past * past);
-    force = k * (e - 0.5 * onset);
-    stiffness = k;
-  }
-  const Vec3d u = d / l;
-  t.energy += energy;
-  t.gradient_b += force * u;
-  // Along the spring its stiffness, across it the tension over the length (both >= 0).
-  const double transverse = force / l;
-  t.hessian += transverse * Mat3d::Identity() + (stiffness - transverse) * u * u.transpose();
 }
 
 // Zero-length seam: k/2 l^2 up to the length where it pulls with `cap`, then a constant pull of
@@ -570,8 +540,8 @@ void ImplicitSolver::Impl::spring_terms(const std::vector<Vec3d>& at, const Impl
       }
       const double rest = m.rest_length[k], stiff = m.stiffness[k];
       add_spring(t, d, l, rest, stiff, exact);
-      if (k >= structural.begin && k < structural.end && l > (limit - 0.5 * kLimitOnset) * rest)
-        add_barrier(t, d, l, (limit - 0.5 * kLimitOnset) * rest, kLimitStiffness * stiff, kLimitOnset * rest);
+      if (k >= structural.begin && k < structural.end && l > limit * rest)
+        add_spring(t, d, l, limit * rest, kLimitStiffness * stiff, exact);
     }
   });
 }

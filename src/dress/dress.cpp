@@ -1,6 +1,7 @@
 // The dressing pipeline (Vassilev & Spanlang sec. 6, docs/dressing.md): each garment in turn is
 // meshed, placed, sewn and draped with the body and the garments already dressed as colliders.
 #include <chrono>
+#include <optional>
 
 #include "dress/stages.hpp"
 #include "dress/waistband.hpp"
@@ -122,6 +123,7 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   result.setup_seconds += since(t0);
 
   std::vector<size_t> beneath;  // per garment: the colliders it was dressed on (body, then layers)
+  std::optional<FitQuality> single_fit;  // one garment whose transferred start was checked
   for (size_t i = 0; i < garments.size(); ++i) {
     beneath.push_back(colliders.size());
     t0 = clock();
@@ -141,8 +143,9 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
       // placement: a body fuller at the waist than the one the garment was dressed on holds a
       // band where it sat there, stretched and pressed into the skin, where one placed anew slides
       // to where the body's girth matches it.
-      if (g.transferred && !all_passed(evaluate_gates(measure_fit(body, std::span(&g, 1)),
-                                                      g.model.fabric.strain_threshold, o.gates))) {
+      std::optional<FitQuality> checked;
+      if (g.transferred) checked = measure_fit(body, std::span(&g, 1));
+      if (checked && !all_passed(evaluate_gates(*checked, g.model.fabric.strain_threshold, o.gates))) {
         const double tried = g.sewing_seconds + g.drape_seconds;
         const uint64_t iterations = g.state.iterations;
         t0 = clock();
@@ -154,6 +157,8 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
         g.transfer_failed = true;
         result.simulation.iterations += iterations;
         result.simulation.wall_seconds += tried;
+      } else if (checked && garments.size() == 1) {
+        single_fit = checked;  // the whole dressing's fit: measuring it again would cost as much
       }
     } else {
       sew_and_drape(g, colliders, o, progress, i, garments.size());
@@ -214,7 +219,9 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
         s.iterations ? s.wall_seconds / static_cast<double>(s.iterations) : 0.0;
   }
 
-  result.quality = measure_fit(result.soft_body ? result.soft_body->body : body, result.garments);
+  result.quality = single_fit && !result.soft_body
+                       ? *single_fit
+                       : measure_fit(result.soft_body ? result.soft_body->body : body, result.garments);
   float threshold = 0;
   for (const DressedGarment& g : result.garments) threshold = std::max(threshold, g.model.fabric.strain_threshold);
   result.gates = evaluate_gates(result.quality, threshold, o.gates);

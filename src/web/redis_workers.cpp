@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "drape/error.hpp"
@@ -92,6 +93,8 @@ void RedisWorkers::work(const std::string& worker) {
     result.tryon = job->tryon;
     const std::filesystem::path staged =
         options_.data_dir / "work" / (is_id(job->tryon) ? job->tryon : random_id());
+    std::optional<Body> body;  // and what passed on it, kept once the result is handed back
+    TryOnOutcome outcome;
     try {
       const CatalogueEntry* garment = catalogue_.find(job->garment);
       const std::optional<std::string> glb = is_id(job->body) ? redis->body(job->body) : std::nullopt;
@@ -103,10 +106,10 @@ void RedisWorkers::work(const std::string& worker) {
         result.error = "the body is gone (deleted or expired)";
       } else {
         redis->set_progress(job->tryon, 0.0, options_.keep);
-        const Body body = body_from_upload(Upload{"body.glb", *glb, "m", "y"}, options_.max_upload_triangles);
+        body = body_from_upload(Upload{"body.glb", *glb, "m", "y"}, options_.max_upload_triangles);
         double shown = 0;
-        const TryOnOutcome outcome = run_tryon(
-            body, *garment, job->size, options_.dress,
+        outcome = run_tryon(
+            *body, *garment, job->size, options_.dress,
             [&](double p) {
               // Throttled: a few hundred updates per try-on at most.
               if (p < shown + 0.01) return;
@@ -134,6 +137,11 @@ void RedisWorkers::work(const std::string& worker) {
       // The job stays in this worker's list; if the worker goes, another takes it up.
       std::fprintf(stderr, "drape serve: worker could not hand back a result: %s\n", e.what());
       redis.reset();
+    }
+    try {
+      if (body && result.done) keep_transfers(transfers_, *body, outcome.passed);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "drape serve: a try-on's drape was not kept as a start: %s\n", e.what());
     }
     --running_;
   }

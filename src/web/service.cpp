@@ -353,6 +353,7 @@ void TryOnService::dress_one(const std::string& id) {
     TryOnOutcome outcome = run_tryon(*body, *catalogue_.find(garment_name), size, options_.dress, set_progress,
                                      staged, &transfers_, PreviewOutput::Leave);
     finish(id, TryOnState::Done, outcome.size, {}, outcome.report, staged, std::move(outcome.preview));
+    keep_transfers(transfers_, *body, outcome.passed);
   } catch (const InputError& e) {
     // A garment file the catalogue took in every size still failed to mesh or place on this body.
     finish(id, TryOnState::Failed, {},

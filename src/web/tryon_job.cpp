@@ -48,10 +48,10 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
     for (const std::string& s : entry.spec.sizes)
       if (size == "auto" || s == size)
         for (auto& t : transfers->for_body(entry.spec.name, s, body)) o.transfers.push_back(std::move(t));
-  const auto keep = [&](const DressResult& r) {
+  std::vector<DressedGarment> passed;
+  const auto keep = [&](DressResult& r) {
     if (transfers && r.passed())
-      for (const DressedGarment& g : r.garments)
-        transfers->add(std::make_shared<GarmentTransfer>(make_garment_transfer(body, g)));
+      for (DressedGarment& g : r.garments) passed.push_back(std::move(g));
   };
   DressResult result;
   FitAnalysis fit;
@@ -68,11 +68,12 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
       for (size_t i = 0; i < advice.sizes.size(); ++i)
         if (advice.sizes[i].size == advice.chart_size) shown = i;
     }
-    for (const SizeTrial& t : advice.sizes) keep(t.result);
     SizeTrial& trial = advice.sizes.at(shown);
     report = nlohmann::json::parse(report_with_fit(dress_report_json(body, trial.result, o), trial.fit));
     report["size_advice"] = nlohmann::json::parse(size_advice_json(body, advice));
     report["size_advice"]["reasons"] = advice.reasons;
+    for (size_t i = 0; i < advice.sizes.size(); ++i)
+      if (i != shown) keep(advice.sizes[i].result);
     result = std::move(trial.result);
     fit = std::move(trial.fit);
   } else {
@@ -84,7 +85,6 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
           p.phase_limit_seconds > 0 ? std::min(1.0, p.simulated_seconds / p.phase_limit_seconds) : 0.0;
       set_progress(0.5 * ((phase.ends_with("draping") ? 1.0 : 0.0) + frac));
     });
-    keep(result);
     const std::vector<Garment> made{garment_in_size(entry.spec, result.garments.at(0).size)};
     fit = analyse_dress_fit(body, result, made);
     report = nlohmann::json::parse(report_with_fit(dress_report_json(body, result, o), fit));
@@ -96,9 +96,15 @@ TryOnOutcome run_tryon(const Body& body, const CatalogueEntry& entry, const std:
   write_dress_outputs(staged, body, result, o, preview);
   write_file_atomic(staged / "report.json", report.dump(2));
   write_scene(staged / "fit.glb", fit_scene(body, result, fit));
-  TryOnOutcome outcome{result.garments.at(0).size, shopper_report(report), std::nullopt};
+  TryOnOutcome outcome{result.garments.at(0).size, shopper_report(report), std::nullopt, {}};
   if (preview == PreviewOutput::Leave) outcome.preview = dress_preview(body, result);
+  keep(result);
+  outcome.passed = std::move(passed);
   return outcome;
+}
+
+void keep_transfers(GarmentTransferStore& transfers, const Body& body, const std::vector<DressedGarment>& passed) {
+  for (const DressedGarment& g : passed) transfers.add(std::make_shared<GarmentTransfer>(make_garment_transfer(body, g)));
 }
 
 }  // namespace drape::web

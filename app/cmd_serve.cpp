@@ -30,6 +30,7 @@ struct ServeArgs {
   double edge = kPaperEdgeLength;
   uint64_t max_iterations = 0;
   size_t max_upload_mb = 64;
+  bool warm_up = true;
 };
 
 void run_serve(const ServeArgs& a) {
@@ -47,6 +48,7 @@ void run_serve(const ServeArgs& a) {
   o.dress.max_iterations = a.max_iterations;
   o.queue_url = a.queue_url;
   o.lease = parse_keep(a.lease);
+  o.warm_up = a.warm_up;
   // SIGINT and SIGTERM stop the server cleanly (workers joined, no half-written try-on left): they
   // are blocked in every thread (the server's inherit the mask) and awaited by one that stops it.
   sigset_t signals;
@@ -125,6 +127,9 @@ void add_serve_command(CLI::App& app) {
          "--max-iterations", args->max_iterations,
          "cap on each try-on's iterations per garment (0: none; a capped try-on fails the settled check)")
       ->capture_default_str();
+  cmd->add_flag("!--no-warm-up", args->warm_up,
+                "start cold: without first dressing the catalogue on the default bodies as starts for "
+                "shoppers' try-ons (the warm-up goes on while no shopper waits)");
   cmd->add_option("--max-upload-mb", args->max_upload_mb, "largest request body in MiB (larger: 413)")
       ->capture_default_str()
       ->check(CLI::Range(1, 1024));

@@ -165,7 +165,8 @@ void WebServer::Impl::routes() {
                    {"version", DRAPE_VERSION},
                    {"workers", s.workers},
                    {"queue", {{"queued", s.queued}, {"running", s.running}, {"capacity", s.capacity}}},
-                   {"tryons", {{"done", s.done}, {"failed", s.failed}, {"turned_away", s.rejected}}}});
+                   {"tryons", {{"done", s.done}, {"failed", s.failed}, {"turned_away", s.rejected}}},
+                   {"warm_up", {{"left", s.warm_up_left}, {"kept", s.warm_up_kept}}}});
   });
 
   http.Get("/api/garments", [this](const httplib::Request&, httplib::Response& res) {

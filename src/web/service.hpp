@@ -53,6 +53,7 @@ struct BodyView {
 
 struct ServiceStats {
   size_t queued = 0, running = 0, capacity = 0, workers = 0, done = 0, failed = 0, rejected = 0;
+  size_t warm_up_left = 0, warm_up_kept = 0;  // warm-up dressings still to do; those kept as starts
 };
 
 class TryOnService {
@@ -97,6 +98,15 @@ class TryOnService {
     std::string job;  // shared queue: the job as queued in Redis
   };
 
+  // One warm-up dressing (ServeOptions::warm_up): a catalogue garment in one size on a default body.
+  struct WarmUp {
+    std::string garment, size;
+    size_t body = 0;  // index into default_bodies_
+  };
+  void plan_warm_up();
+  std::filesystem::path warm_up_file(const WarmUp& job) const;  // data_dir/starts/..., kept across runs
+  void warm_up(const WarmUp& job);
+
   void worker_loop();
   void collector_loop();
   void redis_try(const std::function<void()>& action) const;  // a Redis failure is logged, not thrown
@@ -134,6 +144,10 @@ class TryOnService {
   std::deque<std::string> queue_;
   std::map<std::string, std::shared_ptr<PendingPreview>> previews_;  // try-on id -> its preview to draw
   std::deque<std::string> preview_queue_;                            // in the order they were done
+  std::vector<std::shared_ptr<const Body>> default_bodies_;          // the warm-up's bodies
+  std::deque<WarmUp> warm_ups_;                                      // still to dress, in order
+  bool warming_ = false;                                             // a worker is dressing one
+  size_t warm_ups_kept_ = 0;
   size_t running_ = 0, done_ = 0, failed_ = 0, rejected_ = 0;
   double dress_seconds_total_ = 0;
   std::vector<std::thread> workers_;

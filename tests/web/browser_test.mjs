@@ -35,7 +35,7 @@ const check = (ok, what) => {
 
 // The server: its first line on stdout says the port.
 const server = spawn(drape, ['serve', '--port', '0', '--data', path.join(outDir, 'data'), '--web', webDir,
-                             '--workers', '1', '--keep', '1h', '--edge', '0.035'], { stdio: ['ignore', 'pipe', 'inherit'] });
+                             '--workers', '1', '--keep', '1h', '--edge', '0.035', '--no-warm-up'], { stdio: ['ignore', 'pipe', 'inherit'] });
 const port = await new Promise((resolve, reject) => {
   let text = '';
   server.stdout.on('data', (d) => {

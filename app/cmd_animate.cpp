@@ -33,6 +33,8 @@ struct AnimateArgs {
   std::string skinning = "linear";
   std::string collision = "bvh";
   std::string dress_solver = "explicit";
+  bool dress_solver_given = false;
+  bool soft_body = false;
   int substeps = 3;
   float friction = AnimateOptions{}.friction;
   int threads = 0;
@@ -66,6 +68,13 @@ void run_animate(const AnimateArgs& a) {
   o.substeps = a.substeps;
   o.friction = a.friction;
   o.dress.solver = a.dress_solver == "implicit" ? Solver::Implicit : Solver::Explicit;
+  if (a.soft_body) {
+    // The body gives way under the implicit solver's contact forces: dressed with it too.
+    if (a.dress_solver_given && o.dress.solver != Solver::Implicit)
+      throw InputError("--soft-body", "needs the implicit dressing (--dress-solver implicit)");
+    o.dress.solver = Solver::Implicit;
+    o.dress.soft_body = true;
+  }
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
   // Everything the user gave is read and checked before the long work starts.
@@ -122,6 +131,14 @@ void run_animate(const AnimateArgs& a) {
                r.passed() ? "animated" : "FAILED quality gates", r.frames.size() > 0 ? r.frames.size() - 1 : 0,
                r.simulation_seconds, r.frames_per_wall_second(), r.worst_frame, 100.0 * static_cast<double>(q.max_strain),
                100.0 * q.penetration_fraction, 1e3 * static_cast<double>(q.max_seam_gap_m));
+  if (r.soft_body) {
+    std::fprintf(stderr, "soft body: %d Newton iterations in %.2f s (%.1f ms a frame)", r.soft_body->newton_iterations,
+                 r.soft_body->seconds, r.frames.size() > 1 ? 1e3 * r.soft_body->seconds / static_cast<double>(r.frames.size() - 1) : 0.0);
+    for (const SoftRegionState& g : r.soft_body->worst)
+      std::fprintf(stderr, "; %s in %.1f mm, volume %+.2f %%", g.name.c_str(), 1e3 * static_cast<double>(g.compression_m),
+                   100.0 * g.volume_change);
+    std::fprintf(stderr, "\n");
+  }
   std::fprintf(stderr, "wrote %s/anim.glb, frames.png, report.json%s%s\n", a.out.c_str(), video.empty() ? "" : ", ",
                video.empty() ? "" : video.string().c_str());
   if (!r.passed()) {
@@ -160,6 +177,9 @@ void add_animate_command(CLI::App& app) {
       ->capture_default_str()->check(CLI::IsMember({"image", "bvh", "sdf"}));
   cmd->add_option("--dress-solver", args->dress_solver, "solver that dresses the garments on the bind pose first: explicit or implicit")
       ->capture_default_str()->check(CLI::IsMember({"implicit", "explicit"}));
+  cmd->add_flag("--soft-body", args->soft_body,
+                "let the body give way where the cloth presses, in every frame: its soft regions (belly, buttocks, "
+                "thighs, bust, upper arms) on support springs (docs/soft-body.md; dresses with the implicit solver)");
   cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame")->capture_default_str()->check(CLI::Range(1, 64));
   cmd->add_option("--friction", args->friction,
                   "friction between the cloth and the moving skin (Coulomb coefficient; negative: the fabric's; "
@@ -169,7 +189,10 @@ void add_animate_command(CLI::App& app) {
   cmd->add_flag("--no-video", args->no_video, "write no video (anim.mp4 or frames/)");
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();
   add_load_options(*cmd, args->load);
-  cmd->callback([args] { run_animate(*args); });
+  cmd->callback([args, cmd] {
+    args->dress_solver_given = cmd->get_option("--dress-solver")->count() > 0;
+    run_animate(*args);
+  });
 }
 
 }  // namespace drape::app

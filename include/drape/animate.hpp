@@ -9,11 +9,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "drape/dress.hpp"
 #include "drape/motion.hpp"
+#include "drape/soft_body.hpp"
 
 namespace drape {
 
@@ -49,6 +51,22 @@ struct AnimationProgress {
 };
 using AnimationProgressCallback = std::function<void(const AnimationProgress&)>;
 
+// The body giving way in motion (DressOptions::soft_body, docs/soft-body.md): the support springs
+// work in the bind pose, where the body was dressed. After each frame the cloth's contact forces
+// (ImplicitSolver::contact_forces; their reaction, equal and opposite, spread over the skin) are
+// turned into the bind pose by each vertex's rotation, the soft regions come to rest under them
+// from where they were, and the next frame's body is the bind pose so displaced, skinned: the skin
+// follows the skeleton and gives way where the cloth presses.
+struct AnimatedSoftBody {
+  std::vector<uint32_t> vertices;                // the soft regions' body vertices
+  std::vector<std::vector<Vec3f>> displacement;  // per frame, per listed vertex: its move in the bind pose (m)
+  // Per region, the most over the frames: volume change (by magnitude, its sign kept), compression
+  // and bulge.
+  std::vector<SoftRegionState> worst;
+  double seconds = 0;         // wall: the forces handed to the body and its solves, every frame
+  int newton_iterations = 0;  // of the body's solves
+};
+
 struct AnimationResult {
   BodyAnimation body;                      // the body's skeleton per frame
   DressResult dressed;                     // the garments on the bind pose (frame 0)
@@ -65,6 +83,7 @@ struct AnimationResult {
   ImplicitProfile profile;
   double time_step = 0;                    // s, the longest solver step
   uint64_t solver_steps = 0;               // over all frames (per garment)
+  std::optional<AnimatedSoftBody> soft_body;  // with DressOptions::soft_body
   bool passed() const { return all_passed(gates); }
   double frames_per_wall_second() const;
 };
@@ -76,6 +95,9 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
 
 // The body's vertices in every frame (frames x vertices), skinned as the simulation saw them.
 std::vector<std::vector<Vec3f>> skinned_frames(const Body& body, const BodyAnimation& animation, Skinning method);
+// The body's vertices in every frame of an animation, as the cloth saw them: skinned, and with a
+// soft body, displaced in the bind pose where it gave way first.
+std::vector<std::vector<Vec3f>> animated_body_frames(const Body& body, const AnimationResult& result, Skinning method);
 
 // anim.glb's scene: node `body` skinned, its joints animated (rotations; the root's translation),
 // then one node per garment whose frames are morph targets with a weight animation (frame f: the

@@ -91,6 +91,12 @@ class ImplicitSolver {
   // taking up to mu times the normal force of the tangential force), with contacts found now.
   float residual(std::span<const Vec3f> x, std::span<Collider* const> colliders, const ImplicitSettings& settings);
 
+  // The colliders' force on each particle where the last step ended (N): the contact penalty along
+  // its contact plane's normal and friction across it, as the step applied them; zero out of
+  // contact. `point`: the nearest point of the collider's surface (on the contact plane). A body
+  // that gives way takes the reaction, equal and opposite (drape/soft_body.hpp).
+  void contact_forces(std::span<Vec3f> force, std::span<Vec3f> point) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -11,9 +11,11 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "drape/animate.hpp"
 #include "drape/error.hpp"
+#include "drape/fit_map.hpp"
 
 namespace drape {
 namespace {
@@ -59,6 +61,94 @@ class SharedBodyCollider : public Collider {
   double time_ = std::numeric_limits<double>::quiet_NaN();
 };
 
+// The rotation that takes a vertex's frame in the bind pose (normal n0, the direction e0 to a
+// neighbour) to its frame in a pose (n1, e1).
+Eigen::Matrix3f vertex_rotation(const Vec3f& n0, const Vec3f& e0, const Vec3f& n1, const Vec3f& e1) {
+  const auto frame = [](const Vec3f& n, const Vec3f& e) {
+    const Vec3f t = (e - e.dot(n) * n).normalized();
+    Eigen::Matrix3f m;
+    m.col(0) = n;
+    m.col(1) = t;
+    m.col(2) = n.cross(t);
+    return m;
+  };
+  return frame(n1, e1) * frame(n0, e0).transpose();
+}
+
+// The soft body in motion (AnimatedSoftBody): the bind pose as it gave way, skinned each frame,
+// and the body's rest under the cloth's reaction after each frame.
+class MovingSoftBody {
+ public:
+  MovingSoftBody(const Body& body, const SoftBodyResult& dressed, const SoftBodyOptions& options)
+      : bind_(body), soft_(make_soft_body(body, options)), displaced_(dressed.body) {
+    for (size_t v = 0; v < soft_.region_of.size(); ++v)
+      if (soft_.region_of[v] >= 0) out.vertices.push_back(static_cast<uint32_t>(v));
+    neighbour_.assign(body.mesh.vertex_count(), 0);
+    for (const Tri& t : body.mesh.triangles)
+      for (int k = 0; k < 3; ++k) neighbour_[t[static_cast<size_t>(k)]] = t[static_cast<size_t>((k + 1) % 3)];
+    out.worst = dressed.regions;
+    rest_force_.assign(body.mesh.vertex_count(), Vec3f::Zero());
+  }
+
+  // The body of a frame: the bind pose as it gave way, skinned to `pose`; its displacement kept.
+  void skin(const PoseView& pose, Skinning method, std::span<Vec3f> out_positions) {
+    skin_mesh(displaced_, pose, method, out_positions);
+    std::vector<Vec3f>& d = out.displacement.emplace_back(out.vertices.size());
+    for (size_t k = 0; k < out.vertices.size(); ++k)
+      d[k] = displaced_.mesh.positions[out.vertices[k]] - bind_.mesh.positions[out.vertices[k]];
+  }
+
+  // After a frame on the body at `posed`: the cloth's contact forces on it (their reaction, spread
+  // over the skin), turned into the bind pose, and the body's rest under them from where it was.
+  void give_way(std::span<const Vec3f> posed, std::span<const std::unique_ptr<ImplicitSolver>> solvers,
+                std::span<const DressedGarment> garments) {
+    const auto t0 = Clock::now();
+    const Mesh mesh = posed_mesh(bind_, posed);
+    PressureMap map;
+    map.force.assign(posed.size(), Vec3f::Zero());
+    for (size_t g = 0; g < solvers.size(); ++g) {
+      const ClothModel& model = garments[g].model;
+      ContactForces contacts;
+      contacts.force.resize(model.particle_count());
+      contacts.point.resize(model.particle_count());
+      contacts.footprint.resize(model.particle_count());
+      solvers[g]->contact_forces(contacts.force, contacts.point);
+      const float density = std::max(1e-6f, model.fabric.areal_density);
+      for (size_t i = 0; i < contacts.footprint.size(); ++i) contacts.footprint[i] = std::sqrt(model.mass[i] / density);
+      add_pressure(map, mesh, contacts);
+    }
+    const std::vector<Vec3f> bind_normals = vertex_normals(displaced_.mesh.positions, bind_.mesh.triangles);
+    const std::vector<Vec3f> posed_normals = vertex_normals(mesh.positions, mesh.triangles);
+    for (const uint32_t v : out.vertices) {
+      const uint32_t u = neighbour_[v];
+      const Eigen::Matrix3f rotation =
+          vertex_rotation(bind_normals[v], displaced_.mesh.positions[u] - displaced_.mesh.positions[v], posed_normals[v],
+                          posed[u] - posed[v]);
+      rest_force_[v] = rotation.transpose() * map.force[v];
+    }
+    const SoftSolve solved = solve_soft_body(soft_, rest_force_, displaced_.mesh.positions);
+    displaced_.mesh.positions = solved.positions;
+    out.newton_iterations += solved.newton_iterations;
+    for (size_t k = 0; k < solved.regions.size() && k < out.worst.size(); ++k) {
+      SoftRegionState& w = out.worst[k];
+      const SoftRegionState& now = solved.regions[k];
+      if (std::abs(now.volume_change) > std::abs(w.volume_change)) w.volume_change = now.volume_change;
+      w.compression_m = std::max(w.compression_m, now.compression_m);
+      w.bulge_m = std::max(w.bulge_m, now.bulge_m);
+    }
+    out.seconds += seconds_since(t0);
+  }
+
+  AnimatedSoftBody out;
+
+ private:
+  const Body& bind_;
+  SoftBody soft_;
+  Body displaced_;                 // the bind pose as the body gave way
+  std::vector<uint32_t> neighbour_;  // per vertex: one it shares a triangle with
+  std::vector<Vec3f> rest_force_;  // per vertex: the cloth's force turned into the bind pose
+};
+
 }  // namespace
 
 double AnimationResult::frames_per_wall_second() const {
@@ -69,6 +159,20 @@ double AnimationResult::frames_per_wall_second() const {
 std::vector<std::vector<Vec3f>> skinned_frames(const Body& body, const BodyAnimation& a, Skinning method) {
   std::vector<std::vector<Vec3f>> out(a.frame_count, std::vector<Vec3f>(body.mesh.vertex_count()));
   for (size_t f = 0; f < a.frame_count; ++f) skin_mesh(body, a.pose(f), method, out[f]);
+  return out;
+}
+
+std::vector<std::vector<Vec3f>> animated_body_frames(const Body& body, const AnimationResult& r, Skinning method) {
+  if (!r.soft_body) return skinned_frames(body, r.body, method);
+  const AnimatedSoftBody& s = *r.soft_body;
+  Body displaced = body;
+  std::vector<std::vector<Vec3f>> out(r.body.frame_count, std::vector<Vec3f>(body.mesh.vertex_count()));
+  for (size_t f = 0; f < r.body.frame_count; ++f) {
+    displaced.mesh.positions = body.mesh.positions;
+    if (f < s.displacement.size())
+      for (size_t k = 0; k < s.vertices.size(); ++k) displaced.mesh.positions[s.vertices[k]] += s.displacement[f][k];
+    skin_mesh(displaced, r.body.pose(f), method, out[f]);
+  }
   return out;
 }
 
@@ -86,13 +190,20 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   r.body = retarget(motion, body, o.retarget);
   r.retarget_seconds = seconds_since(start);
   start = Clock::now();
-  const std::vector<std::vector<Vec3f>> skin = skinned_frames(body, r.body, o.skinning);
+  std::vector<std::vector<Vec3f>> skin = skinned_frames(body, r.body, o.skinning);
   r.skinning_seconds = seconds_since(start);
 
   start = Clock::now();
   report("dressing", 0, 0);
   r.dressed = dress(body, garments, o.dress, [&](const DressProgress&) { report("dressing", 0, 0); });
   r.dress_seconds = seconds_since(start);
+  // A soft body: every frame is skinned from the bind pose as it gave way (under the dressing's
+  // garments first, then after each frame under the cloth's contact forces).
+  std::optional<MovingSoftBody> soft;
+  if (r.dressed.soft_body) {
+    soft.emplace(body, *r.dressed.soft_body, o.dress.soft);
+    soft->skin(r.body.pose(0), o.skinning, skin[0]);
+  }
 
   const size_t frames = r.body.frame_count;
   const double frame_time = r.body.frame_time;
@@ -188,6 +299,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   std::vector<float> moved(body.mesh.vertex_count());
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
+    if (soft) soft->skin(r.body.pose(f), o.skinning, skin[f]);
     // Steps this frame: the 95th percentile of the body's vertex travel over the frame, cut into
     // steps of at most max_body_step.
     for (size_t v = 0; v < moved.size(); ++v) moved[v] = (skin[f][v] - skin[f - 1][v]).norm();
@@ -208,11 +320,13 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
         if (k + 1 == steps) residual = std::max(residual, stats.residual);
       }
     r.solver_steps += static_cast<uint64_t>(steps);
+    if (soft && r.status == StepStatus::Ok) soft->give_way(skin[f], solvers, r.dressed.garments);
     r.simulation_seconds += seconds_since(frame_start);
     measure(f, converged, residual, newton);
     report("simulating", f, frames - 1);
   }
   r.collider_seconds = shared.rebuild_seconds;
+  if (soft) r.soft_body = std::move(soft->out);
   if (r.status != StepStatus::Ok) r.frames.resize(r.positions.empty() ? 0 : r.positions[0].size());
 
   // The worst of every key over the frames, and the frame that is worst overall.

@@ -122,6 +122,26 @@ Scene animation_scene(const Body& body, const AnimationResult& r) {
       if (moves) anim.channels.push_back(std::move(tr));
     }
   }
+  if (r.soft_body && frames >= 2) {
+    // The body as it gave way: frame f's displacement in the bind pose is morph target f (glTF
+    // morphs before it skins, as the simulation did), sparse over the soft regions' vertices.
+    Mesh& m = scene.meshes[static_cast<size_t>(scene.nodes[0].mesh)];
+    const AnimatedSoftBody& soft = *r.soft_body;
+    for (size_t f = 0; f < frames; ++f) {
+      MorphTarget t;
+      t.name = fmt::format("frame_{}", f);
+      t.position_deltas.assign(m.positions.size(), Vec3f::Zero());
+      if (f < soft.displacement.size())
+        for (size_t k = 0; k < soft.vertices.size(); ++k) t.position_deltas[soft.vertices[k]] = soft.displacement[f][k];
+      m.morph_targets.push_back(std::move(t));
+    }
+    m.morph_weights.assign(frames, 0.0f);
+    m.morph_weights[0] = 1.0f;
+    AnimationChannel w{0, AnimationPath::Weights, Interpolation::Linear, times, {}};
+    w.values.assign(frames * frames, 0.0f);
+    for (size_t f = 0; f < frames; ++f) w.values[f * frames + f] = 1.0f;
+    anim.channels.push_back(std::move(w));
+  }
   const std::vector<std::string> names = garment_node_names(r);
   for (size_t g = 0; g < r.dressed.garments.size(); ++g) {
     const DressedGarment& dg = r.dressed.garments[g];
@@ -229,13 +249,26 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                         {"strain_threshold", g.model.fabric.strain_threshold}});
   j["garments"] = garments;
   j["dressing"] = {{"passed", r.dressed.passed()}, {"quality", quality_json(r.dressed.quality)}};
+  if (r.soft_body) {
+    nlohmann::ordered_json regions = nlohmann::ordered_json::array();
+    for (const SoftRegionState& g : r.soft_body->worst)
+      regions.push_back({{"name", g.name},
+                         {"vertices", g.vertices},
+                         {"volume_change", g.volume_change},
+                         {"compression_m", g.compression_m},
+                         {"bulge_m", g.bulge_m}});
+    j["soft_body"] = {{"regions", regions},
+                      {"newton_iterations", r.soft_body->newton_iterations},
+                      {"seconds", r.soft_body->seconds},
+                      {"seconds_per_frame", simulated ? r.soft_body->seconds / static_cast<double>(simulated) : 0.0}};
+  }
   return j.dump(2) + "\n";
 }
 
 std::filesystem::path write_animation_outputs(const std::filesystem::path& dir, const Body& body, const Motion& motion,
                                               const AnimationResult& r, const AnimateOptions& o,
                                               const AnimationOutputOptions& out) {
-  const std::vector<std::vector<Vec3f>> skin = skinned_frames(body, r.body, o.skinning);
+  const std::vector<std::vector<Vec3f>> skin = animated_body_frames(body, r, o.skinning);
   const size_t frames = r.frames.size();
 
   // One scale for every picture, from the body's extent over the whole clip.

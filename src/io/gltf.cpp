@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -71,6 +72,7 @@ bool refuse_write(std::string* err, const std::string&, const std::vector<unsign
 // A validated, strided view of one accessor's elements.
 struct AccessorView {
   const unsigned char* data = nullptr;  // null: all zeros (an accessor without a buffer view)
+  std::shared_ptr<const std::vector<unsigned char>> owned;  // a sparse accessor's values, made dense
   size_t count = 0;
   size_t stride = 0;
   size_t components = 0;
@@ -87,6 +89,10 @@ class GltfReader {
  private:
   [[noreturn]] void fail(const std::string& what) const { throw InputError(source_, what); }
 
+  // `length` bytes at `offset` of buffer view `view_index`, all inside it and its buffer.
+  const unsigned char* bytes(int view_index, size_t offset, size_t length, const std::string& what) const;
+  // `v` with a sparse accessor's values put in (a dense copy).
+  AccessorView with_sparse(const tinygltf::Accessor& a, AccessorView v, const std::string& where) const;
   AccessorView view(int index, const std::string& what, std::initializer_list<int> types,
                     std::initializer_list<int> component_types) const;
   std::vector<float> floats(const AccessorView& v) const;
@@ -127,7 +133,6 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
     fail(fmt::format("{}: unexpected type {}", where, type_name(a.type)));
   if (std::find(component_types.begin(), component_types.end(), a.componentType) == component_types.end())
     fail(fmt::format("{}: unexpected component type {}", where, a.componentType));
-  if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
   if (a.count == 0) fail(where + ": count is 0");
   AccessorView v;
   v.components = static_cast<size_t>(tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type)));
@@ -146,7 +151,7 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
     if (a.count > held / element)
       fail(fmt::format("{}: {} elements without a buffer view, more than the file's {} bytes of buffers hold",
                        where, a.count, held));
-    return v;
+    return a.sparse.isSparse ? with_sparse(a, v, where) : v;
   }
   if (static_cast<size_t>(a.bufferView) >= model_.bufferViews.size())
     fail(fmt::format("{}: buffer view {} does not exist", where, a.bufferView));
@@ -167,6 +172,63 @@ AccessorView GltfReader::view(int index, const std::string& what, std::initializ
       (a.count - 1) * v.stride + element > bv.byteLength - a.byteOffset)
     fail(fmt::format("{}: {} elements do not fit in buffer view {}", where, a.count, a.bufferView));
   v.data = buffer.data() + bv.byteOffset + a.byteOffset;
+  return a.sparse.isSparse ? with_sparse(a, v, where) : v;
+}
+
+const unsigned char* GltfReader::bytes(int view_index, size_t offset, size_t length, const std::string& what) const {
+  if (view_index < 0 || static_cast<size_t>(view_index) >= model_.bufferViews.size())
+    fail(fmt::format("{}: buffer view {} does not exist", what, view_index));
+  const tinygltf::BufferView& bv = model_.bufferViews[static_cast<size_t>(view_index)];
+  if (bv.buffer < 0 || static_cast<size_t>(bv.buffer) >= model_.buffers.size())
+    fail(fmt::format("{}: buffer {} does not exist", what, bv.buffer));
+  const std::vector<unsigned char>& buffer = model_.buffers[static_cast<size_t>(bv.buffer)].data;
+  if (bv.byteOffset > buffer.size() || bv.byteLength > buffer.size() - bv.byteOffset || offset > bv.byteLength ||
+      length > bv.byteLength - offset)
+    fail(fmt::format("{}: {} bytes do not fit in buffer view {}", what, length, view_index));
+  return buffer.data() + bv.byteOffset + offset;
+}
+
+AccessorView GltfReader::with_sparse(const tinygltf::Accessor& a, AccessorView v, const std::string& where) const {
+  const size_t element = v.components * static_cast<size_t>(tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType)));
+  const auto& s = a.sparse;
+  if (s.count < 1 || static_cast<size_t>(s.count) > a.count)
+    fail(fmt::format("{}: {} sparse values for {} elements", where, s.count, a.count));
+  const size_t count = static_cast<size_t>(s.count);
+  size_t index_size = 0;
+  switch (s.indices.componentType) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: index_size = 1; break;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: index_size = 2; break;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: index_size = 4; break;
+    default: fail(fmt::format("{}: sparse indices of component type {}", where, s.indices.componentType));
+  }
+  if (s.indices.byteOffset < 0 || s.values.byteOffset < 0) fail(where + ": a sparse byte offset is negative");
+  const unsigned char* indices =
+      bytes(s.indices.bufferView, static_cast<size_t>(s.indices.byteOffset), count * index_size, where + " sparse indices");
+  const unsigned char* values =
+      bytes(s.values.bufferView, static_cast<size_t>(s.values.byteOffset), count * element, where + " sparse values");
+  auto dense = std::make_shared<std::vector<unsigned char>>(a.count * element, 0);
+  if (v.data)
+    for (size_t i = 0; i < a.count; ++i) std::memcpy(dense->data() + i * element, v.data + i * v.stride, element);
+  uint32_t previous = 0;
+  for (size_t k = 0; k < count; ++k) {
+    uint32_t index = 0;
+    if (index_size == 1) {
+      index = indices[k];
+    } else if (index_size == 2) {
+      uint16_t i16;
+      std::memcpy(&i16, indices + 2 * k, 2);
+      index = i16;
+    } else {
+      std::memcpy(&index, indices + 4 * k, 4);
+    }
+    if (index >= a.count) fail(fmt::format("{}: sparse index {} of {} elements", where, index, a.count));
+    if (k > 0 && index <= previous) fail(fmt::format("{}: sparse indices not increasing ({} after {})", where, index, previous));
+    previous = index;
+    std::memcpy(dense->data() + index * element, values + k * element, element);
+  }
+  v.owned = dense;
+  v.data = dense->data();
+  v.stride = element;
   return v;
 }
 
@@ -689,6 +751,50 @@ class GltfWriter {
     return static_cast<int>(model_.accessors.size()) - 1;
   }
 
+  // A morph target's position deltas: sparse where fewer than half the vertices move (a body that
+  // gives way in a few regions), with no data at all where none does (the spec's zeros).
+  int deltas_accessor(const std::vector<Vec3f>& deltas) {
+    std::vector<uint32_t> moved;
+    for (size_t i = 0; i < deltas.size(); ++i)
+      if (deltas[i] != Vec3f::Zero()) moved.push_back(static_cast<uint32_t>(i));
+    const std::vector<float> dense = flatten_deltas(deltas);
+    if (2 * moved.size() >= deltas.size())
+      return accessor(dense.data(), deltas.size(), TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                      TINYGLTF_TARGET_ARRAY_BUFFER, true);
+    tinygltf::Accessor a;
+    a.bufferView = -1;
+    a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    a.count = deltas.size();
+    a.type = TINYGLTF_TYPE_VEC3;
+    a.minValues.assign(3, 0.0);  // the unmoved vertices' zeros count
+    a.maxValues.assign(3, 0.0);
+    if (!moved.empty()) {
+      std::vector<float> values;
+      for (const uint32_t i : moved)
+        for (int c = 0; c < 3; ++c) {
+          const float v = deltas[i][c];
+          values.push_back(v);
+          a.minValues[static_cast<size_t>(c)] = std::min(a.minValues[static_cast<size_t>(c)], static_cast<double>(v));
+          a.maxValues[static_cast<size_t>(c)] = std::max(a.maxValues[static_cast<size_t>(c)], static_cast<double>(v));
+        }
+      a.sparse.isSparse = true;
+      a.sparse.count = static_cast<int>(moved.size());
+      a.sparse.indices.bufferView = view(moved.data(), 4 * moved.size(), 0);
+      a.sparse.indices.byteOffset = 0;
+      a.sparse.indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+      a.sparse.values.bufferView = view(values.data(), 4 * values.size(), 0);
+      a.sparse.values.byteOffset = 0;
+    }
+    model_.accessors.push_back(a);
+    return static_cast<int>(model_.accessors.size()) - 1;
+  }
+  static std::vector<float> flatten_deltas(const std::vector<Vec3f>& deltas) {
+    std::vector<float> out;
+    out.reserve(3 * deltas.size());
+    for (const Vec3f& d : deltas) out.insert(out.end(), {d.x(), d.y(), d.z()});
+    return out;
+  }
+
   int add_mesh(const Mesh& mesh);
   void add_scene(const Scene& scene);
   tinygltf::Model& model() { return model_; }
@@ -759,10 +865,7 @@ int GltfWriter::add_mesh(const Mesh& mesh) {
   }
   for (const MorphTarget& target : mesh.morph_targets) {
     std::map<std::string, int> attrs;
-    if (target.position_deltas.size() == n) {
-      const std::vector<float> f = flatten(target.position_deltas);
-      attrs["POSITION"] = accessor(f.data(), n, TINYGLTF_TYPE_VEC3, kFloat, kArrayBuffer, true);
-    }
+    if (target.position_deltas.size() == n) attrs["POSITION"] = deltas_accessor(target.position_deltas);
     if (target.normal_deltas.size() == n && prim.attributes.count("NORMAL")) {
       const std::vector<float> f = flatten(target.normal_deltas);
       attrs["NORMAL"] = accessor(f.data(), n, TINYGLTF_TYPE_VEC3, kFloat, kArrayBuffer);

@@ -696,6 +696,27 @@ float ImplicitSolver::residual(std::span<const Vec3f> x, std::span<Collider* con
   return w.residual(settings);
 }
 
+void ImplicitSolver::contact_forces(std::span<Vec3f> force, std::span<Vec3f> point) const {
+  const Impl& w = *impl_;
+  if (force.size() != w.n || point.size() != w.n)
+    throw std::invalid_argument("ImplicitSolver::contact_forces: spans not made for this solver's model");
+  for (size_t i = 0; i < w.n; ++i) {
+    force[i] = point[i] = Vec3f::Zero();
+    if (!w.free[i] || !w.in_range[i] || !w.planes_valid) continue;
+    const Vec3d& nrm = w.plane_normal[i];
+    const Vec3d& x = w.x[i];
+    Vec3d f = contact_force(w.contact_k[i], w.depth(i, x)) * nrm;
+    if (w.friction_force[i] > 0) {
+      // Minus the friction energy's gradient (assemble()).
+      const Vec3d u = w.tangential_slip(i, x);
+      const double slip = u.norm();
+      f -= (slip < kFrictionSlip ? w.friction_force[i] / kFrictionSlip : w.friction_force[i] / slip) * u;
+    }
+    force[i] = f.cast<float>();
+    point[i] = Vec3d(x - (nrm.dot(x) + w.plane_offset[i]) * nrm).cast<float>();
+  }
+}
+
 StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> colliders,
                                 const ImplicitSettings& s, ImplicitStepStats* stats, ImplicitProfile* profile) {
   Impl& w = *impl_;

@@ -94,6 +94,63 @@ TEST(Animate, RaisingTheArmsKeepsTheShirtOnTheShoulders) {
   EXPECT_GT(top, armpit);
 }
 
+// A soft body in motion (--soft-body): the walking body gives way where the shirt presses (the
+// bust), keeps each soft region's volume within 3 %, and the shirt stays within the walk's gates on
+// it; only the soft regions' vertices leave the skinned bind pose.
+TEST(Animate, SoftBodyGivesWayUnderTheWalkingShirtAndKeepsItsVolume) {
+  const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
+  if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
+  AnimateOptions o = quick_options(60);
+  o.dress.solver = Solver::Implicit;
+  o.dress.soft_body = true;
+  const AnimationResult r = animate(female(), {{load_garment(default_garment_name()), ""}}, read_motion(path), o);
+  expect_every_frame_within_gates(r, 0.01, 0.02f);
+  EXPECT_TRUE(r.passed());
+  ASSERT_TRUE(r.soft_body.has_value());
+  const AnimatedSoftBody& soft = *r.soft_body;
+  EXPECT_EQ(soft.displacement.size(), r.frames.size());
+  float deepest = 0;
+  for (const SoftRegionState& g : soft.worst) {
+    EXPECT_LT(std::abs(g.volume_change), 0.03) << g.name;
+    deepest = std::max(deepest, g.compression_m);
+  }
+  EXPECT_GT(deepest, 5e-4f) << "the shirt presses the body in somewhere";
+  // The body the cloth saw: the rigid skin but where the soft regions gave way.
+  const auto rigid = skinned_frames(female(), r.body, o.skinning);
+  const auto seen = animated_body_frames(female(), r, o.skinning);
+  const size_t last = r.frames.size() - 1;
+  std::vector<uint8_t> is_soft(female().mesh.vertex_count(), 0);
+  for (const uint32_t v : soft.vertices) is_soft[v] = 1;
+  float static_moved = 0, soft_moved = 0;
+  for (size_t v = 0; v < is_soft.size(); ++v) {
+    float& moved = is_soft[v] ? soft_moved : static_moved;
+    moved = std::max(moved, (seen[last][v] - rigid[last][v]).norm());
+  }
+  EXPECT_EQ(static_moved, 0.0f);
+  EXPECT_GT(soft_moved, 5e-4f);
+  // anim.glb plays the body as it gave way (a morph target per frame, sparse over the soft
+  // regions); report.json has each region's worst.
+  const auto dir = test::temp_dir("animate_soft");
+  AnimationOutputOptions out;
+  out.video = false;
+  write_animation_outputs(dir, female(), read_motion(path), r, o, out);
+  EXPECT_TRUE(test::gltf_is_valid(dir / "anim.glb"));
+  const Scene scene = read_scene(dir / "anim.glb");
+  const int body = scene.find_node("body");
+  ASSERT_GE(body, 0);
+  const Mesh& skin = scene.meshes[static_cast<size_t>(scene.nodes[static_cast<size_t>(body)].mesh)];
+  ASSERT_EQ(skin.morph_targets.size(), r.frames.size());
+  for (size_t k = 0; k < soft.vertices.size(); ++k)
+    ASSERT_EQ(skin.morph_targets[last].position_deltas[soft.vertices[k]], soft.displacement[last][k]);
+  std::ifstream in(dir / "report.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_TRUE(j.contains("soft_body"));
+  EXPECT_EQ(j["soft_body"]["regions"].size(), soft.worst.size());
+  for (const auto& region : j["soft_body"]["regions"])
+    for (const char* key : {"name", "vertices", "volume_change", "compression_m", "bulge_m"})
+      EXPECT_TRUE(region.contains(key)) << key;
+}
+
 TEST(AnimateCli, WritesItsOutputs) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/synthetic/synthetic_arms_raise_cmu_skeleton.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: dressing and rendering are Release tests";
@@ -132,6 +189,11 @@ TEST(AnimateCli, MalformedMotionAndUnknownSkeletonExit2WritingNothing) {
   auto res = test::run_drape("animate --motion '" + bad.string() + "' --out '" + (dir / "out").string() + "'");
   EXPECT_EQ(res.exit_code, 2);
   EXPECT_NE(res.err.find("bad.bvh: line 11: frame 1 value 2 'x' is not a number"), std::string::npos) << res.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  res = test::run_drape("animate --soft-body --dress-solver explicit --motion '" + bad.string() + "' --out '" +
+                        (dir / "out").string() + "'");
+  EXPECT_EQ(res.exit_code, 2);
+  EXPECT_NE(res.err.find("--soft-body"), std::string::npos) << res.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 
   const auto robot = dir / "robot.bvh";

@@ -1,6 +1,8 @@
 // Mesh formats: round trips keep what they must, encodings agree, loaders validate and count.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <Eigen/Geometry>
 #include <fstream>
 
@@ -296,6 +298,64 @@ TEST(Gltf, SkinnedBodySurvivesReadWriteAndValidates) {
   }
   EXPECT_GT(influences, ma.joints.size());  // really skinned: most vertices have several influences
   fs::remove_all(dir);
+}
+
+// Morph targets that move few vertices are written sparse, and one that moves none without data
+// (the spec's zeros); both read back exactly and validate.
+TEST(Gltf, SparseAndEmptyMorphTargetsRoundTrip) {
+  Scene s;
+  Mesh grid;
+  for (int j = 0; j < 10; ++j)
+    for (int i = 0; i < 10; ++i) grid.positions.emplace_back(0.1f * static_cast<float>(i), 0.1f * static_cast<float>(j), 0.0f);
+  for (uint32_t j = 0; j < 9; ++j)
+    for (uint32_t i = 0; i < 9; ++i) {
+      const uint32_t a = 10 * j + i;
+      grid.triangles.push_back({a, a + 1, a + 11});
+      grid.triangles.push_back({a, a + 11, a + 10});
+    }
+  MorphTarget few{"few", std::vector<Vec3f>(100, Vec3f::Zero()), {}};
+  few.position_deltas[3] = Vec3f(0, 0, 0.01f);
+  few.position_deltas[42] = Vec3f(-0.02f, 0, 0.005f);
+  few.position_deltas[99] = Vec3f(0, 0.03f, 0);
+  grid.morph_targets = {few, MorphTarget{"none", std::vector<Vec3f>(100, Vec3f::Zero()), {}}};
+  grid.morph_weights = {1.0f, 0.0f};
+  add_mesh_node(s, grid, "grid");
+  const fs::path dir = test::temp_dir("sparse_morph");
+  write_scene(dir / "scene.glb", s);
+  EXPECT_TRUE(test::gltf_is_valid(dir / "scene.glb"));
+  const Scene r = read_scene(dir / "scene.glb");
+  ASSERT_EQ(r.meshes.size(), 1u);
+  ASSERT_EQ(r.meshes[0].morph_targets.size(), 2u);
+  EXPECT_EQ(r.meshes[0].morph_targets[0].position_deltas, grid.morph_targets[0].position_deltas);
+  EXPECT_EQ(r.meshes[0].morph_targets[1].position_deltas, grid.morph_targets[1].position_deltas);
+  // Smaller than the dense targets would be (2 x 100 x 12 bytes).
+  EXPECT_LT(fs::file_size(dir / "scene.glb"), 100 * 12 + 100 * 12 + 2000u);
+  fs::remove_all(dir);
+
+  // A sparse accessor that reaches outside its elements, or says nothing of its indices' type, is
+  // refused naming it.
+  const nlohmann::json good = nlohmann::json::parse(encode_gltf(s));
+  size_t sparse = 0;
+  while (sparse < good["accessors"].size() && !good["accessors"][sparse].contains("sparse")) ++sparse;
+  ASSERT_LT(sparse, good["accessors"].size());
+  const auto refused = [&](const nlohmann::json& j, const std::string& says) {
+    const std::string text = j.dump();
+    try {
+      parse_scene(std::span(reinterpret_cast<const unsigned char*>(text.data()), text.size()), MeshFormat::Gltf, "t.gltf");
+      ADD_FAILURE() << "accepted: " << says;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::json more = good;
+  more["accessors"][sparse]["sparse"]["count"] = 101;
+  refused(more, "101 sparse values for 100 elements");
+  nlohmann::json float_indices = good;
+  float_indices["accessors"][sparse]["sparse"]["indices"]["componentType"] = 5126;
+  refused(float_indices, "sparse indices of component type 5126");
+  nlohmann::json outside = good;
+  outside["accessors"][sparse]["sparse"]["indices"]["byteOffset"] = 1 << 20;
+  refused(outside, "do not fit in buffer view");
 }
 
 TEST(Gltf, AnimationsMorphTargetsAndHierarchyRoundTrip) {

@@ -9,7 +9,9 @@
 #include <vector>
 
 #include "drape/analytic_colliders.hpp"
+#include "drape/fit_map.hpp"
 #include "drape/implicit.hpp"
+#include "drape/shapes.hpp"
 
 namespace drape {
 namespace {
@@ -174,6 +176,50 @@ TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
   EXPECT_LE(stats.newton_iterations, 1);
   EXPECT_LT(stats.max_move, 1e-6f);
   EXPECT_LE(stats.residual, 0.01f);
+}
+
+// The colliders' forces on the cloth (ImplicitSolver::contact_forces), what a body that gives way
+// takes the reaction of: cloth at rest on a sphere is held up by them, so they carry its weight,
+// act at the sphere's surface, and handed to the sphere's vertices (add_pressure) they are equal
+// and opposite (Newton's third law).
+TEST(ImplicitSolver, ContactForcesOfClothAtRestCarryItsWeightAndTheSphereTakesTheirReaction) {
+  const ClothModel m = cloth_over_sphere(24);
+  ClothState s = initial_state(m);
+  SphereCollider sphere(Vec3f(0, 0, 0), 0.5f);
+  Collider* colliders[] = {&sphere};
+  ImplicitSolver solver(m, 1);
+  ImplicitSettings settings = default_implicit_settings(m);
+  settings.quasi_static = true;
+  settings.time_step = 0.05;
+  ImplicitStepStats stats;
+  for (int steps = 0; steps < 200; ++steps) {
+    ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
+    if (stats.converged && stats.residual <= 0.01f) break;
+  }
+  ASSERT_LE(stats.residual, 0.01f);
+  ContactForces contacts;
+  contacts.force.resize(m.particle_count());
+  contacts.point.resize(m.particle_count());
+  solver.contact_forces(contacts.force, contacts.point);
+  Vec3d total = Vec3d::Zero();
+  double weight = 0;
+  size_t touching = 0;
+  for (size_t i = 0; i < m.particle_count(); ++i) {
+    weight += static_cast<double>(m.mass[i]) * 9.81;
+    total += contacts.force[i].cast<double>();
+    if (contacts.force[i].squaredNorm() == 0.0f) continue;
+    ++touching;
+    EXPECT_NEAR(contacts.point[i].norm(), 0.5f, 1e-4f) << i;
+  }
+  EXPECT_GT(touching, 20u);
+  // At rest each particle is off balance by at most 1 % of its weight.
+  EXPECT_NEAR(total.y(), weight, 0.01 * weight);
+  EXPECT_LT(std::hypot(total.x(), total.z()), 0.01 * weight);
+  const Mesh ball = uv_sphere(0.5f, Vec3f::Zero(), 48, 24);
+  PressureMap map = empty_pressure_map(ball);
+  add_pressure(map, ball, contacts);
+  EXPECT_LT((map.total.cast<double>() + total).norm(), 1e-4 * weight);
+  EXPECT_LT(map.total.y(), 0.0f) << "the cloth presses down on the sphere";
 }
 
 // Implicit Euler at 1/30 s, thirty times the explicit bound, on a cloth swinging from two corners:

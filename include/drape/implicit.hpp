@@ -48,6 +48,15 @@ struct ImplicitSettings {
   // Newton stops once no particle's net force (inertia included) is over this fraction of its
   // weight (or an iteration moved no particle more than 1e-8 m).
   double force_tolerance = 0.002;
+  // The Newton direction: conjugate gradients preconditioned by the step's last factorisation, to
+  // this relative residual in at most `direction_iterations`, else a new factorisation. Tight (the
+  // default, dressing): once they missed in a step, the step factorises every iteration (where the
+  // matrix changed enough for one miss the next mostly misses too). Loose, at least
+  // kLooseDirection (animation asks for 0.5): cheaper, less exact directions that Newton's further
+  // iterations correct, the preconditioner tried again after each factorisation.
+  double direction_tolerance = 1e-3;
+  int direction_iterations = 16;
+  static constexpr double kLooseDirection = 0.1;
   // The springs' exact Hessian blocks (a factorisation that fails, where the cloth buckles, falls
   // back to the projected ones for the rest of the step), else each made positive semi-definite.
   bool exact_hessian = true;

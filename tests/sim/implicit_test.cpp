@@ -148,26 +148,42 @@ TEST(ImplicitSolver, ClothOnASphereRestsOutsideIt) {
   EXPECT_GT(stats.contacts, 10u);
 }
 
+// Cloth dropped on a unit-diameter sphere and draped by quasi-static steps to rest.
+struct ClothAtRestOnASphere {
+  ClothModel model = cloth_over_sphere(24);
+  ClothState state = initial_state(model);
+  SphereCollider sphere{Vec3f(0, 0, 0), 0.5f};
+  ImplicitSolver solver{model, 1};
+  ImplicitSettings settings = [this] {
+    ImplicitSettings s = default_implicit_settings(model);
+    s.quasi_static = true;
+    s.time_step = 0.05;
+    return s;
+  }();
+  // Steps until a step converged with every particle off balance by at most 1 % of its weight.
+  bool settle(ImplicitStepStats& stats) {
+    Collider* colliders[] = {&sphere};
+    for (int steps = 0; steps < 200; ++steps) {
+      if (solver.step(state, colliders, settings, &stats) != StepStatus::Ok) return false;
+      if (stats.converged && stats.residual <= 0.01f) return true;
+    }
+    return false;
+  }
+};
+
 // Static friction is carried from one step to the next (ClothState::friction_slip): cloth at rest
 // on a sphere, held on its slopes by friction, is still at rest at the next step's start, so that
 // step neither moves it nor needs more than a Newton iteration. (Measured from each step's start,
 // friction let go of what it held and the cloth slid until it held again.)
 TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
-  const ClothModel m = cloth_over_sphere(24);
-  ClothState s = initial_state(m);
-  SphereCollider sphere(Vec3f(0, 0, 0), 0.5f);
-  Collider* colliders[] = {&sphere};
-  ImplicitSolver solver(m, 1);
-  ImplicitSettings settings = default_implicit_settings(m);
+  ClothAtRestOnASphere rest;
+  ClothState& s = rest.state;
+  Collider* colliders[] = {&rest.sphere};
+  ImplicitSolver& solver = rest.solver;
+  const ImplicitSettings& settings = rest.settings;
   ASSERT_GT(settings.friction, 0.0f);
-  settings.quasi_static = true;
-  settings.time_step = 0.05;
   ImplicitStepStats stats;
-  for (int steps = 0; steps < 200; ++steps) {
-    ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
-    if (stats.converged && stats.residual <= 0.01f) break;
-  }
-  ASSERT_LE(stats.residual, 0.01f);
+  ASSERT_TRUE(rest.settle(stats));
   ASSERT_EQ(s.friction_slip.size(), s.x.size());
   size_t held = 0;
   for (const Vec3f& u : s.friction_slip) held += u.norm() > 1e-7f ? 1 : 0;
@@ -183,20 +199,11 @@ TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
 // act at the sphere's surface, and handed to the sphere's vertices (add_pressure) they are equal
 // and opposite (Newton's third law).
 TEST(ImplicitSolver, ContactForcesOfClothAtRestCarryItsWeightAndTheSphereTakesTheirReaction) {
-  const ClothModel m = cloth_over_sphere(24);
-  ClothState s = initial_state(m);
-  SphereCollider sphere(Vec3f(0, 0, 0), 0.5f);
-  Collider* colliders[] = {&sphere};
-  ImplicitSolver solver(m, 1);
-  ImplicitSettings settings = default_implicit_settings(m);
-  settings.quasi_static = true;
-  settings.time_step = 0.05;
+  ClothAtRestOnASphere rest;
+  const ClothModel& m = rest.model;
+  ImplicitSolver& solver = rest.solver;
   ImplicitStepStats stats;
-  for (int steps = 0; steps < 200; ++steps) {
-    ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
-    if (stats.converged && stats.residual <= 0.01f) break;
-  }
-  ASSERT_LE(stats.residual, 0.01f);
+  ASSERT_TRUE(rest.settle(stats));
   ContactForces contacts;
   contacts.force.resize(m.particle_count());
   contacts.point.resize(m.particle_count());

@@ -345,6 +345,8 @@ void TryOnService::plan_warm_up() {
     ++warm_ups_kept_;
     return true;
   });
+  std::fprintf(stderr, "drape serve: warming up: %zu starts kept in %s, %zu dressings to go while no shopper waits\n",
+               warm_ups_kept_, (options_.data_dir / "starts").string().c_str(), warm_ups_.size());
 }
 
 std::filesystem::path TryOnService::warm_up_file(const WarmUp& job) const {
@@ -411,6 +413,8 @@ void TryOnService::worker_loop() {
       {
         std::lock_guard lock(mutex_);
         warming_ = false;
+        if (warm_ups_.empty())
+          std::fprintf(stderr, "drape serve: warmed up: %zu starts kept for shoppers' try-ons\n", warm_ups_kept_);
       }
       queue_cv_.notify_all();
       continue;

@@ -39,6 +39,7 @@ RedisWorkers::RedisWorkers(const ServeOptions& options, const Catalogue& catalog
     ids_.push_back(random_id());
     probe.renew_lease(ids_.back(), options.lease);
   }
+  if (options.warm_up && count > 0) warm_up_ = std::make_unique<WarmUp>(catalogue, options, transfers_);
   heartbeat_ = std::thread([this] { heartbeat(); });
   for (const std::string& id : ids_) threads_.emplace_back([this, id] { work(id); });
 }
@@ -87,7 +88,13 @@ void RedisWorkers::work(const std::string& worker) {
       std::this_thread::sleep_for(std::chrono::seconds(1));
       continue;
     }
-    if (!job) continue;
+    if (!job) {
+      // Nothing queued: the next warm-up dressing, if this process warms up and no other worker of
+      // it is dressing one.
+      if (warm_up_)
+        if (const std::optional<WarmUp::Job> warm = warm_up_->take()) warm_up_->dress(*warm);
+      continue;
+    }
     ++running_;
     RedisResult result;
     result.tryon = job->tryon;

@@ -5,12 +5,14 @@
 // files go back into Redis with the result.
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "drape/web.hpp"
 #include "web/catalogue.hpp"
+#include "web/warm_up.hpp"
 
 namespace drape::web {
 
@@ -21,6 +23,7 @@ class RedisWorkers {
   ~RedisWorkers();
   void stop();  // finishes the try-ons being dressed, then returns
   size_t running() const { return running_; }
+  const WarmUp* warm_up() const { return warm_up_.get(); }  // ServeOptions::warm_up
 
  private:
   void work(const std::string& worker);
@@ -29,6 +32,7 @@ class RedisWorkers {
   const ServeOptions& options_;
   const Catalogue& catalogue_;
   GarmentTransferStore transfers_;  // garments dressed here before, to start the next from
+  std::unique_ptr<WarmUp> warm_up_;  // dressed by a worker the queue leaves idle
   std::vector<std::string> ids_;
   std::vector<std::thread> threads_;
   std::thread heartbeat_;

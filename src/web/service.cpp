@@ -14,7 +14,7 @@
 #include "drape/size_advice.hpp"
 #include "web/bodies.hpp"
 #include "web/ids.hpp"
-#include "web/starts.hpp"
+#include "web/warm_up.hpp"
 #include "web/redis_queue.hpp"
 #include "web/redis_workers.hpp"
 #include "web/request_error.hpp"
@@ -96,7 +96,7 @@ TryOnService::TryOnService(const ServeOptions& options, Catalogue& catalogue)
       redis_workers_ = std::make_unique<RedisWorkers>(options_, catalogue_, workers_count_);
     collector_ = std::thread([this] { collector_loop(); });
   } else {
-    if (options_.warm_up && workers_count_ > 0) plan_warm_up();
+    if (options_.warm_up && workers_count_ > 0) warm_up_ = std::make_unique<WarmUp>(catalogue_, options_, transfers_);
     for (size_t i = 0; i < workers_count_; ++i) workers_.emplace_back([this] { worker_loop(); });
   }
   sweeper_ = std::thread([this] { sweeper_loop(); });
@@ -286,8 +286,9 @@ ServiceStats TryOnService::stats() const {
     running = 0;
     for (const auto& [id, t] : tryons_) running += t.view.state == TryOnState::Running;
   }
-  return {queued,  running, capacity_, workers_count_, done_, failed_, rejected_, warm_ups_.size() + (warming_ ? 1u : 0u),
-          warm_ups_kept_};
+  const WarmUp* warm = warm_up_ ? warm_up_.get() : redis_workers_ ? redis_workers_->warm_up() : nullptr;
+  return {queued,  running, capacity_, workers_count_, done_, failed_, rejected_, warm ? warm->left() : 0,
+          warm ? warm->kept() : 0};
 }
 
 int TryOnService::retry_after_seconds() const {
@@ -301,89 +302,16 @@ int TryOnService::retry_after_seconds() const {
   return std::clamp(static_cast<int>(std::ceil(wait)), 1, 600);
 }
 
-void TryOnService::plan_warm_up() {
-  for (const Sex sex : {Sex::Female, Sex::Male}) default_bodies_.push_back(std::make_shared<const Body>(default_body(sex)));
-  // Per garment and body, the size its chart picks for the body: warmed first, for every garment,
-  // then the sizes one away from it, two away, and so on (the sizes shoppers like them ask for most).
-  struct Plan {
-    const CatalogueEntry* entry;
-    size_t body;
-    long chart;  // index into the entry's sizes
-  };
-  std::vector<Plan> plans;
-  size_t most = 1;
-  for (const CatalogueEntry& e : catalogue_.entries())
-    for (size_t b = 0; b < default_bodies_.size(); ++b) {
-      const std::vector<std::string>& sizes = e.spec.sizes;
-      const std::string chart = choose_size(e.spec, default_bodies_[b]->measurements).size;
-      const auto at = std::find(sizes.begin(), sizes.end(), chart);
-      if (at == sizes.end()) {
-        warm_ups_.push_back({e.name, chart, b});  // a garment of one size, not listed
-        continue;
-      }
-      plans.push_back({&e, b, static_cast<long>(at - sizes.begin())});
-      most = std::max(most, sizes.size());
-    }
-  for (long d = 0; d < static_cast<long>(most); ++d)
-    for (const Plan& p : plans) {
-      const std::vector<std::string>& sizes = p.entry->spec.sizes;
-      for (const long at : {p.chart - d, p.chart + d}) {
-        if (at >= 0 && at < static_cast<long>(sizes.size()))
-          warm_ups_.push_back({p.entry->name, sizes[static_cast<size_t>(at)], p.body});
-        if (d == 0) break;
-      }
-    }
-  // Those an earlier run kept in the data folder are starts at once.
-  const double edge = static_cast<double>(options_.dress.mesh.edge_length);
-  std::erase_if(warm_ups_, [&](const WarmUp& job) {
-    const Body& body = *default_bodies_[job.body];
-    std::optional<KeptStart> kept = load_start(warm_up_file(job), body, edge);
-    if (!kept) return false;
-    if (!kept->fits) return true;  // dressed before: the size does not fit the body
-    if (kept->transfer.garment != job.garment || kept->transfer.size != job.size) return false;
-    transfers_.add(std::make_shared<const GarmentTransfer>(std::move(kept->transfer)));
-    ++warm_ups_kept_;
-    return true;
-  });
-  std::fprintf(stderr, "drape serve: warming up: %zu starts kept in %s, %zu dressings to go while no shopper waits\n",
-               warm_ups_kept_, (options_.data_dir / "starts").string().c_str(), warm_ups_.size());
-}
-
-std::filesystem::path TryOnService::warm_up_file(const WarmUp& job) const {
-  return start_file(options_.data_dir, job.garment, job.size, job.body == 0 ? "female" : "male");
-}
-
-void TryOnService::warm_up(const WarmUp& job) {
-  const CatalogueEntry* entry = catalogue_.find(job.garment);
-  const Body& body = *default_bodies_.at(job.body);
-  try {
-    const double edge = static_cast<double>(options_.dress.mesh.edge_length);
-    DressResult r = dress(body, {GarmentRequest{entry->spec, job.size}}, options_.dress);
-    if (!r.passed()) {  // a size that does not fit the body is no start for anyone's
-      save_start(warm_up_file(job), nullptr, mesh_fingerprint(body.mesh), edge);
-      return;
-    }
-    auto kept = std::make_shared<const GarmentTransfer>(make_garment_transfer(body, r.garments.at(0)));
-    transfers_.add(kept);
-    save_start(warm_up_file(job), kept.get(), kept->body_mesh, edge);
-    std::lock_guard lock(mutex_);
-    ++warm_ups_kept_;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "drape serve: warming up %s %s on the default %s body: %s\n", job.garment.c_str(),
-                 job.size.c_str(), job.body == 0 ? "female" : "male", e.what());
-  }
-}
-
 void TryOnService::worker_loop() {
   omp_set_num_threads(omp_threads_per_worker_);
   for (;;) {
     std::string id;
     std::shared_ptr<PendingPreview> preview;
-    std::optional<WarmUp> warm;
+    std::optional<WarmUp::Job> warm;
     {
       std::unique_lock lock(mutex_);
       queue_cv_.wait(lock, [&] {
-        return stopping_ || !queue_.empty() || !preview_queue_.empty() || (!warm_ups_.empty() && !warming_);
+        return stopping_ || !queue_.empty() || !preview_queue_.empty() || (warm_up_ && warm_up_->ready());
       });
       if (stopping_) return;
       if (!preview_queue_.empty() && (queue_.empty() || previews_.size() > kMaxPendingPreviews)) {
@@ -399,9 +327,8 @@ void TryOnService::worker_loop() {
       } else {
         // Nothing a shopper waits for: the next warm-up, one worker at a time, so that a shopper
         // who comes meanwhile finds another worker free.
-        warm = warm_ups_.front();
-        warm_ups_.pop_front();
-        warming_ = true;
+        warm = warm_up_->take();
+        if (!warm) continue;
       }
     }
     if (preview) {
@@ -409,12 +336,9 @@ void TryOnService::worker_loop() {
       continue;
     }
     if (warm) {
-      warm_up(*warm);
+      warm_up_->dress(*warm);
       {
-        std::lock_guard lock(mutex_);
-        warming_ = false;
-        if (warm_ups_.empty())
-          std::fprintf(stderr, "drape serve: warmed up: %zu starts kept for shoppers' try-ons\n", warm_ups_kept_);
+        std::lock_guard lock(mutex_);  // so that no worker misses the wake-up between its check and its wait
       }
       queue_cv_.notify_all();
       continue;

@@ -26,6 +26,7 @@
 #include "web/catalogue.hpp"
 #include "web/redis_queue.hpp"
 #include "web/redis_workers.hpp"
+#include "web/warm_up.hpp"
 
 namespace drape::web {
 
@@ -98,14 +99,6 @@ class TryOnService {
     std::string job;  // shared queue: the job as queued in Redis
   };
 
-  // One warm-up dressing (ServeOptions::warm_up): a catalogue garment in one size on a default body.
-  struct WarmUp {
-    std::string garment, size;
-    size_t body = 0;  // index into default_bodies_
-  };
-  void plan_warm_up();
-  std::filesystem::path warm_up_file(const WarmUp& job) const;  // data_dir/starts/..., kept across runs
-  void warm_up(const WarmUp& job);
 
   void worker_loop();
   void collector_loop();
@@ -144,10 +137,7 @@ class TryOnService {
   std::deque<std::string> queue_;
   std::map<std::string, std::shared_ptr<PendingPreview>> previews_;  // try-on id -> its preview to draw
   std::deque<std::string> preview_queue_;                            // in the order they were done
-  std::vector<std::shared_ptr<const Body>> default_bodies_;          // the warm-up's bodies
-  std::deque<WarmUp> warm_ups_;                                      // still to dress, in order
-  bool warming_ = false;                                             // a worker is dressing one
-  size_t warm_ups_kept_ = 0;
+  std::unique_ptr<WarmUp> warm_up_;  // ServeOptions::warm_up with the in-process queue
   size_t running_ = 0, done_ = 0, failed_ = 0, rejected_ = 0;
   double dress_seconds_total_ = 0;
   std::vector<std::thread> workers_;

@@ -9,6 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fstream>
+
 #include "web/redis_queue.hpp"
 #include "web/web_fixture.hpp"
 
@@ -74,10 +76,12 @@ class WebRedis : public ::testing::Test {
     connection_.reset();
     end(redis_pid_, SIGTERM);
   }
-  pid_t worker(const std::string& tag, const std::vector<std::string>& extra) {
+  // A `drape serve --worker-only` process with its data in temp_dir(tag); cold unless `warm_up`.
+  pid_t worker(const std::string& tag, const std::vector<std::string>& extra, bool warm_up = false) {
     std::vector<std::string> args{DRAPE_BINARY,          "serve", "--worker-only", "--queue", url_,
                                   "--workers",           "1",     "--lease",       "1s",      "--data",
                                   temp_dir(tag).string()};
+    if (!warm_up) args.emplace_back("--no-warm-up");
     args.insert(args.end(), extra.begin(), extra.end());
     return spawn(args);
   }
@@ -128,6 +132,26 @@ TEST_F(WebRedis, AWorkerKilledMidJobHasItsTryOnTakenUpByAnother) {
   EXPECT_EQ(c.Delete("/api/bodies/" + body)->status, 204);
   EXPECT_EQ(connection_->command({"EXISTS", "drape:body:" + body}).value, "0");
   end(second, SIGTERM);
+}
+
+// A worker-only process that the queue leaves idle warms up (ServeOptions::warm_up): its first
+// dressing of the catalogue on a default body is kept in its data folder as a start.
+TEST_F(WebRedis, AnIdleWorkerWarmsUp) {
+  const pid_t idle = worker("web_redis_warm", {}, true);
+  ASSERT_GT(idle, 0);
+  const std::filesystem::path starts =
+      std::filesystem::temp_directory_path() / ("drape_test_web_redis_warm_" + std::to_string(::getpid())) / "starts";
+  bool kept = false;
+  for (int i = 0; i < 3000 && !kept; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(starts, ec)) {
+      std::ifstream in(e.path());
+      kept = kept || json::parse(in, nullptr, false).value("fits", false);
+    }
+  }
+  end(idle, SIGTERM);
+  EXPECT_TRUE(kept) << "no start kept in " << starts;
 }
 
 TEST_F(WebRedis, ServerWorkersTakeTryOnsFromRedisAndTheQueueStaysBounded) {

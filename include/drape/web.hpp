@@ -41,10 +41,11 @@ struct ServeOptions {
   // does not renew its lease for this long is taken for dead and its try-on is queued again.
   std::string queue_url;
   std::chrono::milliseconds lease{std::chrono::seconds(10)};
-  // Warm-up (in-process queue): from the start, one idle worker at a time dresses every garment of
-  // the catalogue in each size on the default female and male bodies, their chart's sizes first,
-  // and keeps each drape that passes as a start for shoppers' try-ons on bodies like them
-  // (docs/web.md). A shopper's try-on always goes first. `drape serve` turns it on.
+  // Warm-up: from the start, one idle worker at a time (per process, with a shared queue too)
+  // dresses every garment of the catalogue in each size on the default female and male bodies,
+  // their chart's sizes first, and keeps each drape that passes as a start for shoppers' try-ons on
+  // bodies like them, also in data_dir/starts for the next run (docs/web.md). A shopper's try-on
+  // always goes first. `drape serve` turns it on.
   bool warm_up = false;
 };
 

@@ -190,20 +190,24 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   r.body = retarget(motion, body, o.retarget);
   r.retarget_seconds = seconds_since(start);
   start = Clock::now();
-  std::vector<std::vector<Vec3f>> skin = skinned_frames(body, r.body, o.skinning);
-  r.skinning_seconds = seconds_since(start);
-
-  start = Clock::now();
   report("dressing", 0, 0);
   r.dressed = dress(body, garments, o.dress, [&](const DressProgress&) { report("dressing", 0, 0); });
   r.dress_seconds = seconds_since(start);
-  // A soft body: every frame is skinned from the bind pose as it gave way (under the dressing's
-  // garments first, then after each frame under the cloth's contact forces).
+
+  // The body's frames, skinned from the bind pose. A soft body: each frame skinned when it comes,
+  // from the bind pose as it gave way (under the dressing's garments first, then after each frame
+  // under the cloth's contact forces).
   std::optional<MovingSoftBody> soft;
-  if (r.dressed.soft_body) {
-    soft.emplace(body, *r.dressed.soft_body, o.dress.soft);
+  if (r.dressed.soft_body) soft.emplace(body, *r.dressed.soft_body, o.dress.soft);
+  start = Clock::now();
+  std::vector<std::vector<Vec3f>> skin;
+  if (soft) {
+    skin.assign(r.body.frame_count, std::vector<Vec3f>(body.mesh.vertex_count()));
     soft->skin(r.body.pose(0), o.skinning, skin[0]);
+  } else {
+    skin = skinned_frames(body, r.body, o.skinning);
   }
+  r.skinning_seconds = seconds_since(start);
 
   const size_t frames = r.body.frame_count;
   const double frame_time = r.body.frame_time;

@@ -700,6 +700,13 @@ namespace {
 
 using io::kFloat;
 
+std::vector<float> flatten(const auto& vectors) {
+  std::vector<float> out;
+  for (const auto& v : vectors)
+    for (int c = 0; c < v.size(); ++c) out.push_back(v[c]);
+  return out;
+}
+
 // Builds a tinygltf model with one buffer; every view starts 4-byte aligned.
 class GltfWriter {
  public:
@@ -757,10 +764,11 @@ class GltfWriter {
     std::vector<uint32_t> moved;
     for (size_t i = 0; i < deltas.size(); ++i)
       if (deltas[i] != Vec3f::Zero()) moved.push_back(static_cast<uint32_t>(i));
-    const std::vector<float> dense = flatten_deltas(deltas);
-    if (2 * moved.size() >= deltas.size())
+    if (2 * moved.size() >= deltas.size()) {
+      const std::vector<float> dense = flatten(deltas);
       return accessor(dense.data(), deltas.size(), TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
                       TINYGLTF_TARGET_ARRAY_BUFFER, true);
+    }
     tinygltf::Accessor a;
     a.bufferView = -1;
     a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
@@ -788,12 +796,6 @@ class GltfWriter {
     model_.accessors.push_back(a);
     return static_cast<int>(model_.accessors.size()) - 1;
   }
-  static std::vector<float> flatten_deltas(const std::vector<Vec3f>& deltas) {
-    std::vector<float> out;
-    out.reserve(3 * deltas.size());
-    for (const Vec3f& d : deltas) out.insert(out.end(), {d.x(), d.y(), d.z()});
-    return out;
-  }
 
   int add_mesh(const Mesh& mesh);
   void add_scene(const Scene& scene);
@@ -805,13 +807,6 @@ class GltfWriter {
 
 constexpr int kArrayBuffer = TINYGLTF_TARGET_ARRAY_BUFFER;
 constexpr int kElementBuffer = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
-
-std::vector<float> flatten(const auto& vectors) {
-  std::vector<float> out;
-  for (const auto& v : vectors)
-    for (int c = 0; c < v.size(); ++c) out.push_back(v[c]);
-  return out;
-}
 
 int GltfWriter::add_mesh(const Mesh& mesh) {
   const size_t n = mesh.positions.size();

@@ -270,6 +270,11 @@ struct ImplicitSolver::Impl {
   double depth(size_t i, const Vec3d& p) const {
     return model.fabric.collision_thickness - (plane_normal[i].dot(p) + plane_offset[i]);
   }
+  // Friction's force on particle i is -friction_scale(i, |u|) u for its slip u: a stiff spring
+  // below kFrictionSlip (static friction), the full Coulomb force above it.
+  double friction_scale(size_t i, double slip) const {
+    return slip < kFrictionSlip ? friction_force[i] / kFrictionSlip : friction_force[i] / slip;
+  }
   // Particle i's tangential slip at `p` from where friction holds it.
   Vec3d tangential_slip(size_t i, const Vec3d& p) const {
     Vec3d u = p - x0[i] - surface_velocity[i] + held_slip[i];
@@ -586,7 +591,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
             const Mat3d tangent = Mat3d::Identity() - nrm * nrm.transpose();
             const Vec3d u = tangent * (x[i] - x0[i] - surface_velocity[i] + held_slip[i]);
             const double slip = u.norm();
-            const double scale = slip < kFrictionSlip ? friction_force[i] / kFrictionSlip : friction_force[i] / slip;
+            const double scale = friction_scale(i, slip);
             grad += scale * u;
             // Sliding: the Coulomb force has no stiffness along the slip, only across it (its
             // direction turns with the slip), so Newton lets the particle slide as far as the
@@ -706,8 +711,7 @@ void ImplicitSolver::contact_forces(std::span<Vec3f> force, std::span<Vec3f> poi
     if (w.friction_force[i] > 0) {
       // Minus the friction energy's gradient (assemble()).
       const Vec3d u = w.tangential_slip(i, x);
-      const double slip = u.norm();
-      f -= (slip < kFrictionSlip ? w.friction_force[i] / kFrictionSlip : w.friction_force[i] / slip) * u;
+      f -= w.friction_scale(i, u.norm()) * u;
     }
     force[i] = f.cast<float>();
     point[i] = Vec3d(x - (nrm.dot(x) + w.plane_offset[i]) * nrm).cast<float>();

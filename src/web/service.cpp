@@ -14,7 +14,6 @@
 #include "drape/size_advice.hpp"
 #include "web/bodies.hpp"
 #include "web/ids.hpp"
-#include "web/warm_up.hpp"
 #include "web/redis_queue.hpp"
 #include "web/redis_workers.hpp"
 #include "web/request_error.hpp"

@@ -39,6 +39,7 @@ struct DressArgs {
   float pull_closed = DressOptions{}.pull_closed_m;
   bool placement_only = false;
   bool soft_body = false;
+  bool no_self_collision = false;
   std::string out = "out";
   LoadOptions load;
 };
@@ -71,6 +72,7 @@ void run_dress(const DressArgs& a) {
   o.pull_closed_m = a.pull_closed;
   o.simulate = !a.placement_only;
   o.soft_body = a.soft_body;
+  o.self_collision = !a.no_self_collision;
   if (a.soft_body && o.solver != Solver::Implicit) throw InputError("--soft-body", "needs the implicit solver (--solver implicit)");
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
@@ -186,6 +188,9 @@ void add_dress_command(CLI::App& app) {
                   "limit, contact and friction inside the solve) or explicit (the paper's explicit Euler with "
                   "velocity modification, sec. 3.3, with the settings under its own heading below)")
       ->capture_default_str()->check(CLI::IsMember({"implicit", "explicit"}));
+  cmd->add_flag("--no-self-collision", args->no_self_collision,
+               "let the garment pass through itself while it drapes (implicit solver; by default its folds, "
+               "collar and sleeves keep the fabric's contact thickness from the rest of it)");
   cmd->add_option("--collision", args->collision, "body collision: image (paper sec. 4.2), bvh (sec. 4.1) or sdf")
       ->capture_default_str()->check(CLI::IsMember({"image", "bvh", "sdf"}));
   cmd->add_option("--mesher", args->mesher, "grid (the paper's rectangular topology) or triangle")

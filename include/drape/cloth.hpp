@@ -348,6 +348,11 @@ struct StrainStats {
 };
 StrainStats strain_stats(const ClothModel& model, std::span<const Vec3f> x,
                          SpringKind kind = SpringKind::Structural);
+
+// How many edges of the cloth's triangles pass through one of its triangles at `x`, leaving out
+// triangles within twice the mean structural rest length of the edge's ends along the sewn cloth
+// (where the cloth is continuous): 0 for a cloth that does not pass through itself.
+size_t self_intersections(const ClothModel& model, std::span<const Vec3f> x);
 // Per particle: the largest stretch of its incident springs of `kind` (for colouring pictures).
 std::vector<float> particle_strain(const ClothModel& model, std::span<const Vec3f> x,
                                    SpringKind kind = SpringKind::Structural);

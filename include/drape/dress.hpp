@@ -39,6 +39,10 @@ struct DressOptions {
   // below that say they are its own (sewing stall, pulled-closed stitches, draping time and damping,
   // strain passes, time step, projection, mass scaling, face clearance).
   Solver solver = Solver::Implicit;
+  // The implicit solver keeps the garment from passing through itself while it drapes (folds, a
+  // collar, a sleeve's two layers; ImplicitSettings::self_collision). Sewing runs without it: panels
+  // placed round the body overlap where they wrap, and their edges pass each other to meet.
+  bool self_collision = true;
   CollisionMethod collision = CollisionMethod::image;
   MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
   std::string fabric;  // empty: each garment's own
@@ -182,6 +186,7 @@ struct DressedGarment {
   StepProfile profile;                // explicit solver
   ImplicitProfile implicit_profile;   // implicit solver
   float residual = 0;                 // largest |net force| / (m g) over the particles at the end
+  size_t self_intersections = 0;      // edges through a triangle of the garment at the end (self_intersections())
 
   // How far the centre of mass fell from where placement put the garment to the end (0 if it rose):
   // a garment that slid down the body. Measured from the placement, not from the end of sewing:

@@ -7,6 +7,8 @@
 //                                                       fabric's threshold s
 //        + sum_seams  seam(|x_b - x_a|)                 zero-length seams (force-capped while sewing)
 //        + sum_i k_c,i / 2 (t - d_i(x_i))^2_+           contact: a penalty inside the thickness t
+//        + sum_(i,T) k_c,i / 2 (t - g_iT(x))^2_+          self-contact: particle i and a triangle T
+//                                                       of the same cloth at gap g (optional)
 //        + sum_i mu lambda_i f(|T_i (x_i - x_n,i)|)     Coulomb friction, lagged (IPC's smoothing)
 //        - sum_i m_i g . x_i                            gravity
 //
@@ -60,6 +62,11 @@ struct ImplicitSettings {
   // The springs' exact Hessian blocks (a factorisation that fails, where the cloth buckles, falls
   // back to the projected ones for the rest of the step), else each made positive semi-definite.
   bool exact_hessian = true;
+  // Self-contact: every free particle is kept the fabric's contact thickness from the triangles of
+  // the same cloth that are not its own neighbourhood on the pattern (a skirt's folds, a collar
+  // turned down, the two layers of a sleeve), with the body contact's penalty, acting on the
+  // particle and the triangle's corners alike (equal and opposite). docs/cloth.md, "Self-contact".
+  bool self_collision = false;
 };
 // Settings from the model's fabric (friction, threshold).
 ImplicitSettings default_implicit_settings(const ClothModel& model);
@@ -70,15 +77,17 @@ struct ImplicitStepStats {
   float max_move = 0;      // m, the largest displacement of a particle over the step
   float residual = 0;      // largest |net force| / (m g) at the end of the step (inertia excluded)
   uint32_t contacts = 0;   // particles within the contact thickness at the end
+  uint32_t self_contacts = 0;  // particle-triangle pairs of the cloth closer than the thickness at the end
   bool converged = false;  // Newton's last iteration moved no particle more than the tolerance
 };
 
 // Wall-clock seconds per stage of the implicit step, summed over steps.
 struct ImplicitProfile {
   double contacts = 0, assemble = 0, factorize = 0, solve = 0, line_search = 0;
+  double self_contacts = 0;  // finding the self-contact pairs
   uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
   uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration, one after a factorisation
-  double total_seconds() const { return contacts + assemble + factorize + solve + line_search; }
+  double total_seconds() const { return contacts + self_contacts + assemble + factorize + solve + line_search; }
 };
 
 // The solver for one model: its sparse pattern and ordering are analysed once, at construction;

@@ -259,6 +259,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     is.direction_tolerance = 0.5;
     is.direction_iterations = 5;
     if (o.friction >= 0) is.friction = o.friction;
+    is.self_collision = o.dress.self_collision;
     settings.push_back(is);
     start_offset.push_back(centre_height(g.state.x) - hips_height(0));
   }

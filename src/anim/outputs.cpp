@@ -202,6 +202,7 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                       {{"skinning", r.skinning_seconds},
                        {"collider", r.collider_seconds},
                        {"contacts", r.profile.contacts},
+                       {"self_contacts", r.profile.self_contacts},
                        {"assemble", r.profile.assemble},
                        {"factorize", r.profile.factorize},
                        {"solve", r.profile.solve},

@@ -222,6 +222,7 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
   result.quality = single_fit && !result.soft_body
                        ? *single_fit
                        : measure_fit(result.soft_body ? result.soft_body->body : body, result.garments);
+  for (DressedGarment& g : result.garments) g.self_intersections = self_intersections(g.model, g.state.x);
   float threshold = 0;
   for (const DressedGarment& g : result.garments) threshold = std::max(threshold, g.model.fabric.strain_threshold);
   result.gates = evaluate_gates(result.quality, threshold, o.gates);

@@ -73,6 +73,12 @@ void sew_and_drape_implicit(DressedGarment& g, std::span<Collider* const> collid
   // Sewing pulls panels from afar and folds them in compression, where the exact Hessian is mostly
   // indefinite: the trousers took 424 Newton iterations with it against 287 without.
   s.exact_hessian = false;
+  // Sewing runs without self-contact: panels placed round the body overlap where they wrap (the
+  // skirt's front and back at its side seams), and their edges pass each other to meet; with it,
+  // the skirt, shirt, trousers and dress each ran to the cap of their Newton iterations, not settled.
+  // What sewing leaves passing through itself is left out of self-contact while draping
+  // (docs/cloth.md, "Self-contact").
+  s.self_collision = false;
   g.seams_closed = widest_gap(g.state, g.seam_pairs) <= o.seam_closed_m;
   for (int k = 0; k < kMaxSewingSteps && !g.seams_closed && g.state.iterations < cap; ++k) {
     g.status = solver.step(g.state, colliders, s, &stats, &g.implicit_profile);
@@ -92,6 +98,7 @@ void sew_and_drape_implicit(DressedGarment& g, std::span<Collider* const> collid
   s.friction = g.model.fabric.friction;
   s.seam_force = 0.0f;
   s.exact_hessian = true;
+  s.self_collision = o.self_collision;
   s.max_newton_iterations = kDrapeNewtonIterations;
   g.residual = std::numeric_limits<float>::infinity();
   const uint64_t drape_start = g.state.iterations;

@@ -35,7 +35,6 @@ struct AnimateArgs {
   std::string dress_solver = "explicit";
   bool dress_solver_given = false;
   bool soft_body = false;
-  bool no_self_collision = false;
   int substeps = 3;
   float friction = AnimateOptions{}.friction;
   int threads = 0;
@@ -69,7 +68,6 @@ void run_animate(const AnimateArgs& a) {
   o.substeps = a.substeps;
   o.friction = a.friction;
   o.dress.solver = a.dress_solver == "implicit" ? Solver::Implicit : Solver::Explicit;
-  o.dress.self_collision = !a.no_self_collision;
   if (a.soft_body) {
     // The body gives way under the implicit solver's contact forces: dressed with it too.
     if (a.dress_solver_given && o.dress.solver != Solver::Implicit)
@@ -182,9 +180,6 @@ void add_animate_command(CLI::App& app) {
   cmd->add_flag("--soft-body", args->soft_body,
                 "let the body give way where the cloth presses, in every frame: its soft regions (belly, buttocks, "
                 "thighs, bust, upper arms) on support springs (docs/soft-body.md; dresses with the implicit solver)");
-  cmd->add_flag("--no-self-collision", args->no_self_collision,
-               "let the garments pass through themselves, while they are dressed and in motion (by default a "
-               "sleeve keeps the fabric's contact distance from the side it swings past)");
   cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame")->capture_default_str()->check(CLI::Range(1, 64));
   cmd->add_option("--friction", args->friction,
                   "friction between the cloth and the moving skin (Coulomb coefficient; negative: the fabric's; "

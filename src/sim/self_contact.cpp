@@ -310,6 +310,15 @@ size_t SelfContactFinder::crossings_on_grid(std::span<const Vec3d> x, std::vecto
     const Tri& tri = m.triangles[edge_first_[e]];
     for (uint32_t v : {edges_[e][0], edges_[e][1], tri[0], tri[1], tri[2]}) (*tangled)[v] = 1;
   }
+  // And every particle sharing an edge with one of those: next to a crossing the cloth lies on both
+  // sides of itself, and the sides taken there hold it as it is as surely as in it.
+  if (tangled && total > 0) {
+    for (const auto& [a, b] : edges_)
+      if ((*tangled)[a] == 1 || (*tangled)[b] == 1) {
+        if ((*tangled)[a] == 0) (*tangled)[a] = 2;
+        if ((*tangled)[b] == 0) (*tangled)[b] = 2;
+      }
+  }
   return total;
 }
 

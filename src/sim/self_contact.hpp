@@ -43,7 +43,7 @@ class SelfContactFinder {
 
   // How many (edge, triangle) pairs of the cloth at `x` cross, leaving out those the pairs exclude:
   // the cloth passing through itself. `tangled` (optional): 1 for the ends of each crossing edge and
-  // the corners of each crossed triangle.
+  // the corners of each crossed triangle, 2 for the particles one edge from those, 0 elsewhere.
   size_t crossings(std::span<const Vec3d> x, std::vector<uint8_t>* tangled = nullptr);
 
   static constexpr size_t kPerParticle = 8;

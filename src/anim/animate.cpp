@@ -201,11 +201,14 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   if (r.dressed.soft_body) soft.emplace(body, *r.dressed.soft_body, o.dress.soft);
   start = Clock::now();
   std::vector<std::vector<Vec3f>> skin;
+  size_t skinned = 0;  // frames skinned so far: the collider never reads past them
   if (soft) {
-    skin.assign(r.body.frame_count, std::vector<Vec3f>(body.mesh.vertex_count()));
+    skin.assign(r.body.frame_count, std::vector<Vec3f>(body.mesh.vertex_count(), Vec3f::Zero()));
     soft->skin(r.body.pose(0), o.skinning, skin[0]);
+    skinned = 1;
   } else {
     skin = skinned_frames(body, r.body, o.skinning);
+    skinned = skin.size();
   }
   r.skinning_seconds = seconds_since(start);
 
@@ -218,11 +221,17 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
 
   // The body's collider, driven by the skinned frames.
   std::unique_ptr<BodyCollider> collider = make_body_collider(body.mesh, o.collision);
-  collider->set_motion([&skin, frame_time, frames](double t, std::span<Vec3f> x) {
-    const double at = std::clamp(t / frame_time, 0.0, static_cast<double>(frames - 1));
+  // A soft body's frames are skinned as they come: a time at or past the last one skinned (the
+  // collider is first brought to 0, a frame's last step ends on the frame) reads that frame alone.
+  collider->set_motion([&skin, &skinned, frame_time](double t, std::span<Vec3f> x) {
+    const double at = std::clamp(t / frame_time, 0.0, static_cast<double>(skinned - 1));
     const size_t f0 = static_cast<size_t>(std::floor(at));
-    const size_t f1 = std::min(f0 + 1, frames - 1);
+    const size_t f1 = std::min(f0 + 1, skinned - 1);
     const float a = static_cast<float>(at - static_cast<double>(f0));
+    if (f1 == f0 || a == 0.0f) {
+      std::copy(skin[f0].begin(), skin[f0].end(), x.begin());
+      return;
+    }
     for (size_t v = 0; v < x.size(); ++v) x[v] = (1 - a) * skin[f0][v] + a * skin[f1][v];
   });
   SharedBodyCollider shared(*collider);
@@ -313,7 +322,10 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   std::vector<float> moved(body.mesh.vertex_count());
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
-    if (soft) soft->skin(r.body.pose(f), o.skinning, skin[f]);
+    if (soft) {
+      soft->skin(r.body.pose(f), o.skinning, skin[f]);
+      skinned = f + 1;
+    }
     // Steps this frame: the 95th percentile of the body's vertex travel over the frame, cut into
     // steps of at most max_body_step.
     for (size_t v = 0; v < moved.size(); ++v) moved[v] = (skin[f][v] - skin[f - 1][v]).norm();

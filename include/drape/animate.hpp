@@ -43,6 +43,9 @@ struct AnimationFrame {
   double time = 0;  // s
   FitQuality quality;
   int newton_iterations = 0;
+  // Outer garments' vertices that went through a garment beneath them (vertices_beneath), summed
+  // over the layers; reported, not gated.
+  size_t vertices_through_layers = 0;
 };
 
 struct AnimationProgress {

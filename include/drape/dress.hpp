@@ -267,6 +267,16 @@ void sew_and_drape_implicit(DressedGarment& garment, std::span<Collider* const> 
 // A dressed garment as a collider for the next layer: its surface pushed out by its thickness.
 std::unique_ptr<Collider> garment_collider(const DressedGarment& garment);
 
+// The same for a garment in motion: its surface follows `positions` (its particles, which must
+// outlive the collider), read at each update to a new time, with their velocity since the last.
+std::unique_ptr<Collider> moving_garment_collider(const DressedGarment& garment, const std::vector<Vec3f>& positions);
+
+// How many of an outer garment's vertices have gone through the inner garment (at
+// `inner_positions`): more than `tolerance` past its surface, on the body's side (within 2 cm of
+// it; the side from its angle-weighted pseudo-normals).
+size_t vertices_beneath(const DressedGarment& inner, std::span<const Vec3f> inner_positions,
+                        std::span<const Vec3f> outer, float tolerance = 0.002f);
+
 // Stage 7: quality over all garments against the body.
 FitQuality measure_fit(const Body& body, std::span<const DressedGarment> garments);
 

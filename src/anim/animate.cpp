@@ -5,8 +5,9 @@
 //
 // Why the implicit solver: a frame of 1/30 s is a few implicit steps, where the explicit step's
 // stability bound (eq. 4) asks for about fifty, and every step must rebuild the body collider
-// (refit its tree to the skinned mesh). The body is the collider of every garment; garments do not
-// collide with each other while moving (dressing layers them on the bind pose).
+// (refit its tree to the skinned mesh). The body is the collider of every garment, and each garment
+// of the garments beneath it, as in dressing (sec. 6): each step the garments step innermost first,
+// and an outer one meets the inner ones where they have just gone, with their velocity.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -236,9 +237,9 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   });
   SharedBodyCollider shared(*collider);
   shared.update(0.0);
-  std::vector<Collider*> colliders{&shared};
 
   std::vector<ClothState> states;
+  states.reserve(r.dressed.garments.size());  // the layers' colliders read the states in place
   std::vector<std::unique_ptr<ImplicitSolver>> solvers;
   std::vector<ImplicitSettings> settings;
   std::vector<float> start_offset;  // garment centre above the hips in frame 0
@@ -251,7 +252,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     s.time = 0;
     std::fill(s.v.begin(), s.v.end(), Vec3f::Zero());
     states.push_back(std::move(s));
-    solvers.push_back(std::make_unique<ImplicitSolver>(g.model, 1));
+    solvers.push_back(std::make_unique<ImplicitSolver>(g.model, 1 + solvers.size()));
     ImplicitSettings is = default_implicit_settings(g.model);
     is.time_step = r.time_step;
     is.moving_colliders = true;
@@ -274,6 +275,17 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // run 1.29 % at its last (the gates 7 % and 1 %).
     settings.push_back(is);
     start_offset.push_back(centre_height(g.state.x) - hips_height(0));
+  }
+  // Per garment: the body, then the garments beneath it, following their particles.
+  std::vector<std::unique_ptr<Collider>> layers;
+  std::vector<std::vector<Collider*>> colliders(ng);
+  for (size_t g = 0; g < ng; ++g) {
+    colliders[g].push_back(&shared);
+    for (size_t inner = 0; inner < g; ++inner) colliders[g].push_back(layers[inner].get());
+    if (g + 1 < ng) {
+      layers.push_back(moving_garment_collider(r.dressed.garments[g], states[g].x));
+      layers.back()->update(0.0);
+    }
   }
 
   const auto measure = [&](size_t f, bool settled, float residual, int newton) {
@@ -304,6 +316,8 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
       gap_sum += static_cast<double>(gaps.mean) * static_cast<double>(gaps.pairs);
       pairs += gaps.pairs;
       q.drop_m = std::max(q.drop_m, start_offset[g] - (centre_height(s.x) - hips_height(f)));
+      for (size_t inner = 0; inner < g; ++inner)
+        fr.vertices_through_layers += vertices_beneath(r.dressed.garments[inner], states[inner].x, s.x);
     }
     if (!all_strain.empty()) {
       const size_t k = std::min(all_strain.size() - 1, static_cast<size_t>(0.99 * static_cast<double>(all_strain.size())));
@@ -340,7 +354,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
       for (size_t g = 0; g < ng && r.status == StepStatus::Ok; ++g) {
         ImplicitStepStats stats;
         settings[g].time_step = frame_time / steps;
-        r.status = solvers[g]->step(states[g], colliders, settings[g], &stats, &r.profile);
+        r.status = solvers[g]->step(states[g], colliders[g], settings[g], &stats, &r.profile);
         converged = converged && stats.converged;
         newton += stats.newton_iterations;
         if (k + 1 == steps) residual = std::max(residual, stats.residual);

@@ -180,7 +180,8 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                       {"quality", quality_json(r.frames[f].quality)},
                       {"drop_m", number(r.frames[f].quality.drop_m)},
                       {"lowest_y_m", number(r.frames[f].quality.lowest_y)},
-                      {"newton_iterations", r.frames[f].newton_iterations}});
+                      {"newton_iterations", r.frames[f].newton_iterations},
+                      {"vertices_through_layers", r.frames[f].vertices_through_layers}});
   j["quality"] = quality_json(r.worst);
   j["frames"] = frames;
   j["worst_frame"] = r.worst_frame;

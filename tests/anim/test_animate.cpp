@@ -95,6 +95,24 @@ TEST(Animate, RaisingTheArmsKeepsTheShirtOnTheShoulders) {
   EXPECT_GT(top, armpit);
 }
 
+// Two layers walking: the shirt over the skirt meets the skirt where it has just moved (the
+// garments beneath an outer one are its colliders in motion too, as in dressing), and stays
+// outside it on every frame.
+TEST(Animate, AShirtOverASkirtWalksOutsideIt) {
+  const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
+  if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
+  const AnimationResult r =
+      animate(female(), {{load_garment("skirt"), ""}, {load_garment(default_garment_name()), ""}}, read_motion(path), quick_options(120));
+  ASSERT_EQ(r.positions.size(), 2u);
+  EXPECT_GE(r.frames.size(), 30u);
+  expect_every_frame_within_gates(r, 0.01, 0.02f);
+  const size_t shirt = r.positions[1][0].size();
+  size_t worst = 0;
+  for (const AnimationFrame& f : r.frames) worst = std::max(worst, f.vertices_through_layers);
+  EXPECT_LE(worst, shirt / 100) << "of the shirt's " << shirt << " vertices, through the skirt";
+  EXPECT_TRUE(r.passed());
+}
+
 // A soft body in motion (--soft-body): the walking body gives way where the shirt presses (the
 // bust), keeps each soft region's volume within 3 %, and the shirt stays within the walk's gates on
 // it; only the soft regions' vertices leave the skinned bind pose.

@@ -488,6 +488,18 @@ TEST(DressScene, TwoLayers) {
   const DressResult r = dress(cached_body(Sex::Female), {{load_garment("skirt"), ""}, {load_garment("shirt"), ""}});
   ASSERT_EQ(r.garments.size(), 2u);
   expect_sound(r);
+  const DressedGarment &skirt = r.garments[0], &shirt = r.garments[1];
+  EXPECT_EQ(vertices_beneath(skirt, skirt.state.x, shirt.state.x), 0u);
+  // The count sees what went through: the skirt's own surface 5 mm inside it is beneath it (but
+  // at its waist and hem, where the nearest point is an edge), 5 mm outside is not.
+  const std::vector<Vec3f> normals = vertex_normals(skirt.state.x, skirt.model.triangles);
+  std::vector<Vec3f> inside(skirt.state.x), outside(skirt.state.x);
+  for (size_t i = 0; i < inside.size(); ++i) {
+    inside[i] -= 0.005f * normals[i];
+    outside[i] += 0.005f * normals[i];
+  }
+  EXPECT_GT(vertices_beneath(skirt, skirt.state.x, inside), 9 * inside.size() / 10);
+  EXPECT_EQ(vertices_beneath(skirt, skirt.state.x, outside), 0u);
 }
 
 // The run is deterministic: the same input gives the same final state (bit for bit).

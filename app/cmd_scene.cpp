@@ -290,6 +290,14 @@ void run_scene(const SceneArgs& a) {
   for (int st = 0; st < StepProfile::StageCount; ++st)
     stages[std::string(StepProfile::name(static_cast<StepProfile::Stage>(st)))] = run.profile.seconds[st];
   report["simulation"]["stage_seconds"] = stages;
+  if (scene.implicit) {
+    const ImplicitProfile& p = run.implicit_profile;
+    report["simulation"]["newton_iterations"] = p.newton_iterations;
+    report["simulation"]["factorizations"] = p.factorizations;
+    report["simulation"]["implicit_stage_seconds"] = {{"contacts", p.contacts}, {"assemble", p.assemble},
+                                                      {"factorize", p.factorize}, {"solve", p.solve},
+                                                      {"line_search", p.line_search}};
+  }
   report["scene"] = {{"obstacle", a.obstacle},
                      {"n", a.n},
                      {"fabric", o.fabric.name},

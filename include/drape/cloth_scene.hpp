@@ -64,7 +64,8 @@ struct SceneRun {
   StepStatus status = StepStatus::Ok;
   uint64_t iterations = 0;
   double wall_seconds = 0;  // stepping only
-  StepProfile profile;
+  StepProfile profile;              // the explicit step's stages
+  ImplicitProfile implicit_profile;  // the implicit solver's
 };
 // Steps until settled, failed (status) or max_time. `progress` (may be empty) is called about every
 // 0.25 s of simulated time.

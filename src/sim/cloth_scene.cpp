@@ -83,7 +83,8 @@ SceneRun run_until_settled(ClothScene& scene, const SettleCriteria& criteria,
   const auto start = std::chrono::steady_clock::now();
   double calm_since = -1, next_report = 0.25;
   while (scene.state.time < criteria.max_time) {
-    run.status = scene.implicit ? scene.implicit->step(scene.state, scene.colliders, scene.implicit_settings)
+    run.status = scene.implicit ? scene.implicit->step(scene.state, scene.colliders, scene.implicit_settings, nullptr,
+                                                       &run.implicit_profile)
                                 : step(scene.model, scene.state, scene.colliders, scene.settings, scene.scratch, &run.profile);
     if (run.status != StepStatus::Ok) break;
     const double t = scene.state.time;

@@ -217,7 +217,9 @@ TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
   EXPECT_GT(held, 10u) << "friction holds the cloth on the sphere's slopes";
   ASSERT_EQ(solver.step(s, colliders, settings, &stats), StepStatus::Ok);
   EXPECT_LE(stats.newton_iterations, 1);
-  EXPECT_LT(stats.max_move, 1e-6f);
+  // At rest to within 10 um: the last iteration's roundings (float positions, 40 ulp of 0.3 m)
+  // move it by 1.2 um in the sanitizer build's code (-O1), under 1 um in the release build's.
+  EXPECT_LT(stats.max_move, 1e-5f);
   EXPECT_LE(stats.residual, 0.01f);
 }
 

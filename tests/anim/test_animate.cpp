@@ -170,6 +170,22 @@ TEST(Animate, SoftBodyGivesWayUnderTheWalkingShirtAndKeepsItsVolume) {
       EXPECT_TRUE(region.contains(key)) << key;
 }
 
+// A soft body walking in the dress stays within the walk's gates on every frame (the dress is
+// loose: the body hardly gives way under it).
+TEST(Animate, SoftBodyWalkingInTheDressStaysWithinTheGates) {
+  const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
+  if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
+  AnimateOptions o = quick_options(120);
+  o.dress.solver = Solver::Implicit;
+  o.dress.soft_body = true;
+  const AnimationResult r = animate(female(), {{load_garment("dress"), ""}}, read_motion(path), o);
+  EXPECT_GE(r.frames.size(), 30u);
+  expect_every_frame_within_gates(r, 0.01, 0.02f);
+  EXPECT_TRUE(r.passed());
+  ASSERT_TRUE(r.soft_body.has_value());
+  for (const SoftRegionState& g : r.soft_body->worst) EXPECT_LT(std::abs(g.volume_change), 0.03) << g.name;
+}
+
 // The soft body in motion is skinned a frame at a time; the collider, brought to the start and
 // to the end of each frame, reads only frames already skinned: the same run on one thread and on
 // two gives the same cloth and the same body, bit for bit.

@@ -33,6 +33,14 @@ AnimateOptions quick_options(long last_frame) {
   return o;
 }
 
+// The same on a body that gives way (dressed with the implicit solver, as its soft body needs).
+AnimateOptions soft_body_options(long last_frame) {
+  AnimateOptions o = quick_options(last_frame);
+  o.dress.solver = Solver::Implicit;
+  o.dress.soft_body = true;
+  return o;
+}
+
 void expect_every_frame_within_gates(const AnimationResult& r, double max_penetration_fraction, float strain_margin) {
   ASSERT_EQ(r.status, StepStatus::Ok);
   for (size_t f = 0; f < r.frames.size(); ++f) {
@@ -119,9 +127,7 @@ TEST(Animate, AShirtOverASkirtWalksOutsideIt) {
 TEST(Animate, SoftBodyGivesWayUnderTheWalkingShirtAndKeepsItsVolume) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
-  AnimateOptions o = quick_options(60);
-  o.dress.solver = Solver::Implicit;
-  o.dress.soft_body = true;
+  const AnimateOptions o = soft_body_options(60);
   const AnimationResult r = animate(female(), {{load_garment(default_garment_name()), ""}}, read_motion(path), o);
   expect_every_frame_within_gates(r, 0.01, 0.02f);
   EXPECT_TRUE(r.passed());
@@ -175,9 +181,7 @@ TEST(Animate, SoftBodyGivesWayUnderTheWalkingShirtAndKeepsItsVolume) {
 TEST(Animate, SoftBodyWalkingInTheDressStaysWithinTheGates) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
-  AnimateOptions o = quick_options(120);
-  o.dress.solver = Solver::Implicit;
-  o.dress.soft_body = true;
+  const AnimateOptions o = soft_body_options(120);
   const AnimationResult r = animate(female(), {{load_garment("dress"), ""}}, read_motion(path), o);
   EXPECT_GE(r.frames.size(), 30u);
   expect_every_frame_within_gates(r, 0.01, 0.02f);
@@ -192,9 +196,7 @@ TEST(Animate, SoftBodyWalkingInTheDressStaysWithinTheGates) {
 TEST(Animate, SoftBodyInMotionIsTheSameOnAnyThreadCount) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_02_01_walk.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: the walk is a Release test";
-  AnimateOptions o = quick_options(4);
-  o.dress.solver = Solver::Implicit;
-  o.dress.soft_body = true;
+  const AnimateOptions o = soft_body_options(4);
   const Motion walk = read_motion(path);
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

@@ -35,6 +35,7 @@ struct AnimateArgs {
   std::string dress_solver = "explicit";
   bool dress_solver_given = false;
   bool soft_body = false;
+  bool skin_layer = false;
   int substeps = 3;
   float friction = AnimateOptions{}.friction;
   int threads = 0;
@@ -75,6 +76,7 @@ void run_animate(const AnimateArgs& a) {
     o.dress.solver = Solver::Implicit;
     o.dress.soft_body = true;
   }
+  o.skin_layer = a.skin_layer;
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
   // Everything the user gave is read and checked before the long work starts.
@@ -139,6 +141,15 @@ void run_animate(const AnimateArgs& a) {
                    100.0 * g.volume_change);
     std::fprintf(stderr, "\n");
   }
+  if (r.skin_layer) {
+    const AnimatedSkinLayer& k = *r.skin_layer;
+    std::fprintf(stderr,
+                 "skin layer: %.1f mm kept between body parts; skinned, up to %zu vertices inside another part (%.1f mm "
+                 "deep); with the skin layer %zu (%.1f mm); skin moved up to %.1f mm; %.1f ms a frame\n",
+                 1e3 * static_cast<double>(k.gap_m), k.inside_skinned, 1e3 * static_cast<double>(k.depth_skinned_m), k.inside,
+                 1e3 * static_cast<double>(k.depth_m), 1e3 * static_cast<double>(k.max_move_m),
+                 r.frames.empty() ? 0.0 : 1e3 * k.seconds / static_cast<double>(r.frames.size()));
+  }
   std::fprintf(stderr, "wrote %s/anim.glb, frames.png, report.json%s%s\n", a.out.c_str(), video.empty() ? "" : ", ",
                video.empty() ? "" : video.string().c_str());
   if (!r.passed()) {
@@ -180,6 +191,10 @@ void add_animate_command(CLI::App& app) {
   cmd->add_flag("--soft-body", args->soft_body,
                 "let the body give way where the cloth presses, in every frame: its soft regions (belly, buttocks, "
                 "thighs, bust, upper arms) on support springs (docs/soft-body.md; dresses with the implicit solver)");
+  cmd->add_flag("--skin-layer", args->skin_layer,
+                "keep the body's parts out of each other where skinning drives them in (hands lowered onto the hips, an "
+                "arm against the torso): a skin on zero-length springs to the skinned body, pushed apart where two parts "
+                "meet, with room for the cloth between (docs/soft-body.md)");
   cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame")->capture_default_str()->check(CLI::Range(1, 64));
   cmd->add_option("--friction", args->friction,
                   "friction between the cloth and the moving skin (Coulomb coefficient; negative: the fabric's; "

@@ -10,11 +10,13 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "drape/dress.hpp"
 #include "drape/motion.hpp"
+#include "drape/skin_layer.hpp"
 #include "drape/soft_body.hpp"
 
 namespace drape {
@@ -35,6 +37,13 @@ struct AnimateOptions {
   // body, strain at most the fabric's threshold + 2 %, seams within 5 mm, nothing below the floor,
   // no garment sliding off (its centre 15 cm lower against the hips than when dressed), no NaN.
   QualityGates gates{0.005f, 0.01, 0.02f, 0.0f, 0.15f};
+  // The skin layer (drape/skin_layer.hpp, Cordier et al.): each frame's skinned body is the
+  // reference of a physical skin, and where skinning drives one body part into another (hands
+  // lowered onto the hips, an arm against the torso) their skin is pushed apart, equal and opposite,
+  // before the cloth meets it. The gap kept is at least twice the garments' thicknesses (a layer
+  // of each garment on either skin), so the cloth caught between has room.
+  bool skin_layer = false;
+  SkinLayerOptions skin;
 };
 
 // One frame's measures: DESIGN.md's `quality` keys over all garments (settled: every solver step
@@ -46,6 +55,9 @@ struct AnimationFrame {
   // Outer garments' vertices that went through a garment beneath them (vertices_beneath), summed
   // over the layers; reported, not gated.
   size_t vertices_through_layers = 0;
+  // With AnimateOptions::skin_layer: skin vertices more than 1 mm inside another body part, as
+  // skinning left them and as the skin layer did.
+  size_t skin_inside_skinned = 0, skin_inside = 0;
 };
 
 struct AnimationProgress {
@@ -70,6 +82,21 @@ struct AnimatedSoftBody {
   int newton_iterations = 0;  // of the body's solves
 };
 
+// The skin layer in motion (AnimateOptions::skin_layer): per frame, the skin's moves off the
+// skinned body, turned into the bind pose (morphed before it is skinned, they give the skin as the
+// cloth met it), over the vertices that moved.
+struct AnimatedSkinLayer {
+  std::vector<std::vector<uint32_t>> vertices;   // per frame
+  std::vector<std::vector<Vec3f>> displacement;  // per frame, per listed vertex (m, bind pose)
+  float gap_m = 0;
+  // The most over the frames: vertices inside another body part, skinned and with the skin layer,
+  // and their deepest; the largest move of a vertex off the skinned body.
+  size_t inside_skinned = 0, inside = 0;
+  float depth_skinned_m = 0, depth_m = 0, max_move_m = 0;
+  size_t contacts = 0;  // the most contacts in a frame
+  double seconds = 0;   // wall: the skin layer's solves (its measures not counted)
+};
+
 struct AnimationResult {
   BodyAnimation body;                      // the body's skeleton per frame
   DressResult dressed;                     // the garments on the bind pose (frame 0)
@@ -87,6 +114,7 @@ struct AnimationResult {
   double time_step = 0;                    // s, the longest solver step
   uint64_t solver_steps = 0;               // over all frames (per garment)
   std::optional<AnimatedSoftBody> soft_body;  // with DressOptions::soft_body
+  std::optional<AnimatedSkinLayer> skin_layer;  // with AnimateOptions::skin_layer
   bool passed() const { return all_passed(gates); }
   double frames_per_wall_second() const;
 };
@@ -99,8 +127,11 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
 // The body's vertices in every frame (frames x vertices), skinned as the simulation saw them.
 std::vector<std::vector<Vec3f>> skinned_frames(const Body& body, const BodyAnimation& animation, Skinning method);
 // The body's vertices in every frame of an animation, as the cloth saw them: skinned, and with a
-// soft body, displaced in the bind pose where it gave way first.
+// soft body or the skin layer, displaced in the bind pose where it gave way first.
 std::vector<std::vector<Vec3f>> animated_body_frames(const Body& body, const AnimationResult& result, Skinning method);
+// Adds frame f's displacement of the body in the bind pose (a soft body's, the skin layer's) to
+// `bind` (every body vertex); nothing without either.
+void add_body_displacement(const AnimationResult& result, size_t frame, std::span<Vec3f> bind);
 
 // anim.glb's scene: node `body` skinned, its joints animated (rotations; the root's translation),
 // then one node per garment whose frames are morph targets with a weight animation (frame f: the

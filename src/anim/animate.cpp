@@ -14,6 +14,9 @@
 #include <limits>
 #include <optional>
 
+#include <Eigen/LU>
+
+#include "anim/motion_internal.hpp"
 #include "drape/animate.hpp"
 #include "drape/error.hpp"
 #include "drape/fit_map.hpp"
@@ -163,15 +166,20 @@ std::vector<std::vector<Vec3f>> skinned_frames(const Body& body, const BodyAnima
   return out;
 }
 
+void add_body_displacement(const AnimationResult& r, size_t f, std::span<Vec3f> bind) {
+  if (r.soft_body && f < r.soft_body->displacement.size())
+    for (size_t k = 0; k < r.soft_body->vertices.size(); ++k) bind[r.soft_body->vertices[k]] += r.soft_body->displacement[f][k];
+  if (r.skin_layer && f < r.skin_layer->displacement.size())
+    for (size_t k = 0; k < r.skin_layer->vertices[f].size(); ++k) bind[r.skin_layer->vertices[f][k]] += r.skin_layer->displacement[f][k];
+}
+
 std::vector<std::vector<Vec3f>> animated_body_frames(const Body& body, const AnimationResult& r, Skinning method) {
-  if (!r.soft_body) return skinned_frames(body, r.body, method);
-  const AnimatedSoftBody& s = *r.soft_body;
+  if (!r.soft_body && !r.skin_layer) return skinned_frames(body, r.body, method);
   Body displaced = body;
   std::vector<std::vector<Vec3f>> out(r.body.frame_count, std::vector<Vec3f>(body.mesh.vertex_count()));
   for (size_t f = 0; f < r.body.frame_count; ++f) {
     displaced.mesh.positions = body.mesh.positions;
-    if (f < s.displacement.size())
-      for (size_t k = 0; k < s.vertices.size(); ++k) displaced.mesh.positions[s.vertices[k]] += s.displacement[f][k];
+    add_body_displacement(r, f, displaced.mesh.positions);
     skin_mesh(displaced, r.body.pose(f), method, out[f]);
   }
   return out;
@@ -219,6 +227,55 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   const size_t ng = r.dressed.garments.size();
   r.positions.assign(ng, {});
   r.frames.resize(frames);
+
+  // The skin layer: each frame's skin comes to rest on the skinned body, its parts kept apart by a
+  // gap with room for a layer of every garment on either skin.
+  std::optional<SkinLayer> skin_layer;
+  if (o.skin_layer) {
+    SkinLayerOptions so = o.skin;
+    float thickness = 0;
+    for (const DressedGarment& g : r.dressed.garments) thickness += g.model.fabric.collision_thickness;
+    so.gap = std::max(so.gap, 2.0f * thickness);
+    skin_layer.emplace(body, so);
+    r.skin_layer.emplace();
+    r.skin_layer->gap_m = so.gap;
+    r.skin_layer->vertices.resize(frames);
+    r.skin_layer->displacement.resize(frames);
+  }
+  std::vector<Vec3f> skinned_only;
+  std::vector<Eigen::Matrix3f> linear;
+  const auto lay_skin = [&](size_t f) {
+    if (!skin_layer) return;
+    AnimatedSkinLayer& k = *r.skin_layer;
+    skinned_only = skin[f];
+    const SkinContactStats before = skin_layer->inside(skinned_only);
+    const auto t0 = Clock::now();
+    const SkinContactStats st = skin_layer->solve(skinned_only, skin[f]);
+    // The moves, turned into the bind pose.
+    std::vector<uint32_t>& moved_vertices = k.vertices[f];
+    for (size_t v = 0; v < skin[f].size(); ++v)
+      if (skin[f][v] != skinned_only[v]) moved_vertices.push_back(static_cast<uint32_t>(v));
+    linear.resize(moved_vertices.size());
+    motion_detail::skinning_linear_parts(body, r.body.pose(f), o.skinning, moved_vertices, linear);
+    k.displacement[f].resize(moved_vertices.size());
+    for (size_t i = 0; i < moved_vertices.size(); ++i) {
+      const uint32_t v = moved_vertices[i];
+      const Eigen::FullPivLU<Eigen::Matrix3f> lu(linear[i]);
+      const Vec3f move = skin[f][v] - skinned_only[v];
+      k.displacement[f][i] = lu.isInvertible() ? Vec3f(lu.solve(move)) : move;
+    }
+    k.seconds += seconds_since(t0);
+    const SkinContactStats after = skin_layer->inside(skin[f]);
+    r.frames[f].skin_inside_skinned = before.vertices_inside;
+    r.frames[f].skin_inside = after.vertices_inside;
+    k.inside_skinned = std::max(k.inside_skinned, before.vertices_inside);
+    k.depth_skinned_m = std::max(k.depth_skinned_m, before.max_depth_m);
+    k.inside = std::max(k.inside, after.vertices_inside);
+    k.depth_m = std::max(k.depth_m, after.max_depth_m);
+    k.max_move_m = std::max(k.max_move_m, st.max_move_m);
+    k.contacts = std::max(k.contacts, st.contacts);
+  };
+  for (size_t f = 0; f < skinned; ++f) lay_skin(f);
 
   // The body's collider, driven by the skinned frames.
   std::unique_ptr<BodyCollider> collider = make_body_collider(body.mesh, o.collision);
@@ -327,13 +384,15 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   };
   measure(0, true, r.dressed.quality.residual, 0);
 
-  r.simulation_seconds = r.skinning_seconds;
+  // The skin layer of frames skinned before the loop counts with the skinning.
+  r.simulation_seconds = r.skinning_seconds + (r.skin_layer && !soft ? r.skin_layer->seconds : 0.0);
   std::vector<float> moved(body.mesh.vertex_count());
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
     if (soft) {
       soft->skin(r.body.pose(f), o.skinning, skin[f]);
       skinned = f + 1;
+      lay_skin(f);
     }
     // Steps this frame: the 95th percentile of the body's vertex travel over the frame, cut into
     // steps of at most max_body_step.

@@ -50,5 +50,10 @@ std::vector<uint32_t> foot_vertices(const Body& body, int foot_joint);
 // Skins only the listed vertices (out[i] for vertices[i]).
 void skin_vertices(const Body& body, const PoseView& pose, Skinning method, std::span<const uint32_t> vertices,
                    std::span<Vec3f> out);
+// The linear part of the listed vertices' skinning (out[i] for vertices[i]): a displacement d of
+// the vertex in the bind pose moves its posed position by out[i] d (exactly for linear blend
+// skinning, whose posed position is linear in the bind one; dual quaternions: the blended rotation).
+void skinning_linear_parts(const Body& body, const PoseView& pose, Skinning method, std::span<const uint32_t> vertices,
+                           std::span<Eigen::Matrix3f> out);
 
 }  // namespace drape::motion_detail

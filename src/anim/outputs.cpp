@@ -122,17 +122,16 @@ Scene animation_scene(const Body& body, const AnimationResult& r) {
       if (moves) anim.channels.push_back(std::move(tr));
     }
   }
-  if (r.soft_body && frames >= 2) {
-    // The body as it gave way: frame f's displacement in the bind pose is morph target f (glTF
-    // morphs before it skins, as the simulation did), sparse over the soft regions' vertices.
+  if ((r.soft_body || r.skin_layer) && frames >= 2) {
+    // The body as it gave way (a soft body) and as the skin layer kept its parts apart: frame f's
+    // displacement in the bind pose is morph target f (glTF morphs before it skins, as the
+    // simulation did), sparse over the vertices that moved.
     Mesh& m = scene.meshes[static_cast<size_t>(scene.nodes[0].mesh)];
-    const AnimatedSoftBody& soft = *r.soft_body;
     for (size_t f = 0; f < frames; ++f) {
       MorphTarget t;
       t.name = fmt::format("frame_{}", f);
       t.position_deltas.assign(m.positions.size(), Vec3f::Zero());
-      if (f < soft.displacement.size())
-        for (size_t k = 0; k < soft.vertices.size(); ++k) t.position_deltas[soft.vertices[k]] = soft.displacement[f][k];
+      add_body_displacement(r, f, t.position_deltas);
       m.morph_targets.push_back(std::move(t));
     }
     m.morph_weights.assign(frames, 0.0f);
@@ -182,6 +181,10 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                       {"lowest_y_m", number(r.frames[f].quality.lowest_y)},
                       {"newton_iterations", r.frames[f].newton_iterations},
                       {"vertices_through_layers", r.frames[f].vertices_through_layers}});
+  if (r.skin_layer)
+    for (size_t f = 0; f < r.frames.size(); ++f)
+      frames[f]["skin_layer"] = {{"vertices_inside_skinned", r.frames[f].skin_inside_skinned},
+                                 {"vertices_inside", r.frames[f].skin_inside}};
   j["quality"] = quality_json(r.worst);
   j["frames"] = frames;
   j["worst_frame"] = r.worst_frame;
@@ -263,6 +266,18 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                       {"newton_iterations", r.soft_body->newton_iterations},
                       {"seconds", r.soft_body->seconds},
                       {"seconds_per_frame", simulated ? r.soft_body->seconds / static_cast<double>(simulated) : 0.0}};
+  }
+  if (r.skin_layer) {
+    const AnimatedSkinLayer& k = *r.skin_layer;
+    j["skin_layer"] = {{"gap_m", k.gap_m},
+                       {"vertices_inside_skinned", k.inside_skinned},
+                       {"max_depth_skinned_m", k.depth_skinned_m},
+                       {"vertices_inside", k.inside},
+                       {"max_depth_m", k.depth_m},
+                       {"max_move_m", k.max_move_m},
+                       {"contacts", k.contacts},
+                       {"seconds", k.seconds},
+                       {"seconds_per_frame", r.frames.empty() ? 0.0 : k.seconds / static_cast<double>(r.frames.size())}};
   }
   return j.dump(2) + "\n";
 }

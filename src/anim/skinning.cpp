@@ -111,6 +111,39 @@ void motion_detail::skin_vertices(const Body& body, const PoseView& pose, Skinni
   for (size_t i = 0; i < vertices.size(); ++i) out[i] = skin_one(body, jt, method, vertices[i]);
 }
 
+void motion_detail::skinning_linear_parts(const Body& body, const PoseView& pose, Skinning method,
+                                          std::span<const uint32_t> vertices, std::span<Eigen::Matrix3f> out) {
+  const std::vector<JointTransform> jt = joint_transforms(body, pose);
+  const size_t nv = body.mesh.vertex_count();
+  const bool rigged = body.mesh.joints.size() == nv && body.mesh.weights.size() == nv && jt.size() == body.skeleton.joints.size();
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    out[i].setIdentity();
+    if (!rigged) continue;
+    const auto& joints = body.mesh.joints[vertices[i]];
+    const Vec4f& weights = body.mesh.weights[vertices[i]];
+    Eigen::Matrix3f sum = Eigen::Matrix3f::Zero();
+    Eigen::Vector4f real = Eigen::Vector4f::Zero(), pivot = Eigen::Vector4f::Zero();
+    float total = 0;
+    bool any = false;
+    for (int k = 0; k < 4; ++k) {
+      const float w = weights[k];
+      if (w <= 0 || joints[static_cast<size_t>(k)] >= jt.size()) continue;
+      const JointTransform& t = jt[joints[static_cast<size_t>(k)]];
+      sum += w * t.r;
+      total += w;
+      const Eigen::Vector4f r = t.real.coeffs();
+      if (!any) pivot = r, any = true;
+      real += (r.dot(pivot) < 0 ? -w : w) * r;
+    }
+    if (method == Skinning::Linear) {
+      if (total > 0) out[i] = sum / total;
+    } else if (any && real.norm() > 0) {
+      real.normalize();
+      out[i] = Quatf(real[3], real[0], real[1], real[2]).toRotationMatrix();
+    }
+  }
+}
+
 std::vector<uint32_t> motion_detail::foot_vertices(const Body& body, int foot_joint) {
   const size_t nj = body.skeleton.joints.size();
   std::vector<char> in_foot(nj, 0);

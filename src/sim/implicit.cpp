@@ -67,6 +67,11 @@ inline double contact_stiffness(double k, double d) { return d > 0 ? k * (1.0 + 
 constexpr double kFrictionSlip = 1e-4;  // m
 // A contact plane is found anew once its particle moved this far from where it was found.
 constexpr double kReplane = 1e-3;  // m
+// A contact plane found anew whose normal is more than 60 degrees from the last one's is another
+// wall of a crease; the last is kept beside it while the particle is within kCreaseReach past the
+// thickness of it.
+constexpr double kCreaseCosine = 0.5;
+constexpr double kCreaseReach = 2e-3;  // m
 // Self-contact keeps this fraction of the fabric's contact thickness (1 mm of the default 4 mm)
 // between a particle and the cloth's other triangles. Where cloth lies in two layers on the body,
 // or is caught between an arm and the side, the layers' distance presses the inner one towards the
@@ -247,6 +252,12 @@ struct ImplicitSolver::Impl {
   std::vector<Vec3d> plane_normal;        // per particle: contact plane d(x) = n.x + c
   std::vector<double> plane_offset;
   std::vector<uint8_t> in_range;          // a surface within the query radius
+  // A second plane where the nearest surface moved to another wall of a crease (the crotch between
+  // the thighs): the wall it left, kept while the particle is within its reach, so that the particle
+  // rests against both (one plane at a time, Newton's iterates went from one wall to the other).
+  std::vector<Vec3d> crease_normal;
+  std::vector<double> crease_offset;
+  std::vector<uint8_t> in_crease;
   std::vector<double> friction_force;     // per particle: lagged normal force x mu (N)
   std::vector<Vec3d> surface_velocity;
   std::vector<Vec3d> held_slip;           // per particle: the slip friction held at the step's start
@@ -279,6 +290,9 @@ struct ImplicitSolver::Impl {
   // How far `p` is inside particle i's contact layer (thickness - distance to its plane).
   double depth(size_t i, const Vec3d& p) const {
     return model.fabric.collision_thickness - (plane_normal[i].dot(p) + plane_offset[i]);
+  }
+  double crease_depth(size_t i, const Vec3d& p) const {
+    return model.fabric.collision_thickness - (crease_normal[i].dot(p) + crease_offset[i]);
   }
   // Friction's force on particle i is -friction_scale(i, |u|) u for its slip u: a stiff spring
   // below kFrictionSlip (static friction), the full Coulomb force above it.
@@ -359,6 +373,9 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
   plane_normal.assign(n, Vec3d::UnitY());
   plane_offset.assign(n, 0.0);
   in_range.assign(n, 0);
+  crease_normal.assign(n, Vec3d::UnitY());
+  crease_offset.assign(n, 0.0);
+  in_crease.assign(n, 0);
   friction_force.assign(n, 0.0);
   surface_velocity.assign(n, Vec3d::Zero());
   held_slip.assign(n, Vec3d::Zero());
@@ -499,9 +516,24 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
     for (size_t q = begin; q < end; ++q) {
       const size_t i = refresh[q];
       const ContactSample& c = sample[q];
+      const bool was = in_range[i] != 0;
       in_range[i] = c.distance < radius ? 1 : 0;
-      if (!in_range[i]) continue;
-      plane_normal[i] = c.normal.cast<double>().normalized();
+      if (!in_range[i]) {
+        in_crease[i] = 0;
+        continue;
+      }
+      const Vec3d normal = c.normal.cast<double>().normalized();
+      // Planes found anew for all (a step's start with colliders that move) start without one.
+      if (refresh_all) {
+        in_crease[i] = 0;
+      } else if (was && normal.dot(plane_normal[i]) < kCreaseCosine && depth(i, x[i]) > -kCreaseReach) {
+        crease_normal[i] = plane_normal[i];
+        crease_offset[i] = plane_offset[i];
+        in_crease[i] = 1;
+      } else if (in_crease[i] && crease_depth(i, x[i]) <= -kCreaseReach) {
+        in_crease[i] = 0;
+      }
+      plane_normal[i] = normal;
       plane_offset[i] = static_cast<double>(c.distance) - plane_normal[i].dot(x[i]);
       surface_velocity[i] = c.velocity.cast<double>() * h;  // the surface's displacement over the step
     }
@@ -541,6 +573,7 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       if (!in_range[i]) continue;
       const double pen = depth(i, at[i]);
       if (pen > 0) e += contact_energy(contact_k[i], pen);
+      if (in_crease[i]) e += contact_energy(contact_k[i], crease_depth(i, at[i]));
       if (friction_force[i] > 0) {
         const double u = tangential_slip(i, at[i]).norm();
         e += friction_force[i] * (u < kFrictionSlip ? 0.5 * u * u / kFrictionSlip : u - 0.5 * kFrictionSlip);
@@ -754,6 +787,12 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
             grad -= contact_force(contact_k[i], pen) * nrm;
             diag += contact_stiffness(contact_k[i], pen) * nrm * nrm.transpose();
           }
+          const double crease = in_crease[i] ? crease_depth(i, x[i]) : 0.0;
+          if (crease > 0) {
+            const Vec3d& cn = crease_normal[i];
+            grad -= contact_force(contact_k[i], crease) * cn;
+            diag += contact_stiffness(contact_k[i], crease) * cn * cn.transpose();
+          }
           if (friction_force[i] > 0) {
             const Mat3d tangent = Mat3d::Identity() - nrm * nrm.transpose();
             const Vec3d u = tangent * (x[i] - x0[i] - surface_velocity[i] + held_slip[i]);
@@ -839,6 +878,7 @@ float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
       const double pen = depth(i, x[i]);
       const double normal_force = contact_force(contact_k[i], pen);
       force += normal_force * nrm;
+      if (in_crease[i]) force += contact_force(contact_k[i], crease_depth(i, x[i])) * crease_normal[i];
       if (normal_force > 0) {
         // Static friction takes up to mu N of the tangential force.
         const Vec3d tangential = force - nrm.dot(force) * nrm;
@@ -880,6 +920,7 @@ void ImplicitSolver::contact_forces(std::span<Vec3f> force, std::span<Vec3f> poi
     const Vec3d& nrm = w.plane_normal[i];
     const Vec3d& x = w.x[i];
     Vec3d f = contact_force(w.contact_k[i], w.depth(i, x)) * nrm;
+    if (w.in_crease[i]) f += contact_force(w.contact_k[i], w.crease_depth(i, x)) * w.crease_normal[i];
     if (w.friction_force[i] > 0) {
       // Minus the friction energy's gradient (assemble()).
       const Vec3d u = w.tangential_slip(i, x);

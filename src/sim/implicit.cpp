@@ -67,10 +67,11 @@ inline double contact_stiffness(double k, double d) { return d > 0 ? k * (1.0 + 
 constexpr double kFrictionSlip = 1e-4;  // m
 // A contact plane is found anew once its particle moved this far from where it was found.
 constexpr double kReplane = 1e-3;  // m
-// A contact plane found anew whose normal is more than 60 degrees from the last one's is another
+// A contact plane found anew whose normal is more than 90 degrees from the last one's is another
 // wall of a crease; the last is kept beside it while the particle is within kCreaseReach past the
-// thickness of it.
-constexpr double kCreaseCosine = 0.5;
+// thickness of it. From 60 degrees, the default trousers on the female body took 431 Newton
+// iterations instead of 254 (planes of one wall's curve kept as a crease's).
+constexpr double kCreaseCosine = 0.0;
 constexpr double kCreaseReach = 2e-3;  // m
 // Self-contact keeps this fraction of the fabric's contact thickness (1 mm of the default 4 mm)
 // between a particle and the cloth's other triangles. Where cloth lies in two layers on the body,

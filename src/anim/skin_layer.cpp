@@ -55,6 +55,17 @@ struct Candidate {
   double base = 0;                   // J u there: the gap at u is distance + J u - base
 };
 
+// J u for a contact: the vertex's move against its contact point's, along the normal.
+double relative_move(const Candidate& c, const std::vector<Vec3d>& u) {
+  Vec3d rel = u[c.vertex];
+  for (size_t j = 0; j < 3; ++j) rel -= c.weight[j] * u[c.corner[j]];
+  return c.normal.dot(rel);
+}
+// The contact's gap at u, less the gap kept: < 0 where it is closed.
+double gap_at(const Candidate& c, const std::vector<Vec3d>& u, double gap) {
+  return c.distance - gap + relative_move(c, u) - c.base;
+}
+
 }  // namespace
 
 struct SkinLayer::Impl {
@@ -239,12 +250,6 @@ SkinContactStats SkinLayer::solve(std::span<const Vec3f> reference, std::span<Ve
   const double gap = static_cast<double>(w.options.gap);
   if (out.data() != reference.data()) std::copy(reference.begin(), reference.end(), out.begin());
   std::vector<Vec3d> u(n, Vec3d::Zero());
-  const auto relative = [&](const Candidate& c) {
-    Vec3d rel = u[c.vertex];
-    for (int j = 0; j < 3; ++j) rel -= c.weight[static_cast<size_t>(j)] * u[c.corner[static_cast<size_t>(j)]];
-    return c.normal.dot(rel);
-  };
-  const auto gap_at_u = [&](const Candidate& c) { return c.distance - gap + relative(c) - c.base; };
   // The contacts of the last call (the previous frame) carried over, against the same triangle:
   // where skinning drives a part into another over several frames, the pair keeps the side it met
   // on, which a nearest point found afresh deep inside a thin part (a hand) would not.
@@ -275,18 +280,17 @@ SkinContactStats SkinLayer::solve(std::span<const Vec3f> reference, std::span<Ve
     w.pose(out);
     w.find(out, true, false, [&](double distance) { return distance < gap + kCandidateMargin; }, w.slot, w.slot_used);
     bool fresh_closed = false;
+    w.candidates.clear();
     for (size_t k = 0; k < w.slot.size(); ++k) {
       if (!w.slot_used[k]) continue;
       Candidate& c = w.slot[k];
-      if (std::isnan(c.base)) c.base = relative(c);
+      if (std::isnan(c.base)) c.base = relative_move(c, u);
+      w.candidates.push_back(c);
     }
-    w.candidates.clear();
-    for (size_t k = 0; k < w.slot.size(); ++k)
-      if (w.slot_used[k]) w.candidates.push_back(w.slot[k]);
     const size_t nc = w.candidates.size();
     w.closed.assign(nc, 0);
     for (size_t c = 0; c < nc; ++c) {
-      w.closed[c] = gap_at_u(w.candidates[c]) < 0 ? 1 : 0;
+      w.closed[c] = gap_at(w.candidates[c], u, gap) < 0 ? 1 : 0;
       fresh_closed = fresh_closed || w.closed[c];
     }
     if (!fresh_closed) break;
@@ -295,7 +299,7 @@ SkinContactStats SkinLayer::solve(std::span<const Vec3f> reference, std::span<Ve
     for (size_t v = 0; v < n; ++v) out[v] = reference[v] + u[v].cast<float>();
   }
   s.contacts = 0;
-  for (size_t c = 0; c < w.candidates.size(); ++c) s.contacts += gap_at_u(w.candidates[c]) < 1e-4 ? 1u : 0u;
+  for (size_t c = 0; c < w.candidates.size(); ++c) s.contacts += gap_at(w.candidates[c], u, gap) < 1e-4 ? 1u : 0u;
   Vec3d net = Vec3d::Zero();
   for (size_t v = 0; v < n; ++v) {
     net += w.anchor[v] * u[v];
@@ -314,11 +318,6 @@ SkinContactStats SkinLayer::solve(std::span<const Vec3f> reference, std::span<Ve
 
 bool SkinLayer::Impl::solve_closed(double gap, std::vector<Vec3d>& u, SkinContactStats& s) {
   const size_t nc = candidates.size();
-  const auto relative = [&](const Candidate& c) {
-    Vec3d rel = u[c.vertex];
-    for (int j = 0; j < 3; ++j) rel -= c.weight[static_cast<size_t>(j)] * u[c.corner[static_cast<size_t>(j)]];
-    return c.normal.dot(rel);
-  };
   int rings = kRings;
   for (int it = 0; it < kMaxActiveSetIterations; ++it) {
     s.iterations += it > 0 ? 1 : 0;
@@ -396,7 +395,7 @@ bool SkinLayer::Impl::solve_closed(double gap, std::vector<Vec3d>& u, SkinContac
     bool grew = false;
     for (size_t c = 0; c < nc; ++c) {
       const Candidate& cc = candidates[c];
-      if (!closed[c] && cc.distance - gap + relative(cc) - cc.base < 0) {
+      if (!closed[c] && gap_at(cc, u, gap) < 0) {
         closed[c] = 1;
         grew = true;
       }

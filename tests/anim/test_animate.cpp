@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "drape/animate.hpp"
+#include "anim_outputs.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
 
@@ -156,11 +157,7 @@ TEST(Animate, SoftBodyGivesWayUnderTheWalkingShirtAndKeepsItsVolume) {
   // anim.glb plays the body as it gave way (a morph target per frame, sparse over the soft
   // regions); report.json has each region's worst.
   const auto dir = test::temp_dir("animate_soft");
-  AnimationOutputOptions out;
-  out.video = false;
-  write_animation_outputs(dir, female(), read_motion(path), r, o, out);
-  EXPECT_TRUE(test::gltf_is_valid(dir / "anim.glb"));
-  const Scene scene = read_scene(dir / "anim.glb");
+  const Scene scene = test::written_animation(dir, female(), read_motion(path), r, o);
   const int body = scene.find_node("body");
   ASSERT_GE(body, 0);
   const Mesh& skin = scene.meshes[static_cast<size_t>(scene.nodes[static_cast<size_t>(body)].mesh)];

@@ -13,6 +13,7 @@
 
 #include "drape/animate.hpp"
 #include "drape/skin_layer.hpp"
+#include "anim_outputs.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
 
@@ -162,11 +163,7 @@ TEST(SkinLayer, InMotionKeepsThePartsApartAndTheShirtBetween) {
   // anim.glb plays it (a morph target per frame) and passes the Khronos validator; report.json has
   // the skin layer's figures, per frame and in all.
   const auto dir = test::temp_dir("animate_skin_layer");
-  AnimationOutputOptions out;
-  out.video = false;
-  write_animation_outputs(dir, female(), lowered_arms(path), r, o, out);
-  EXPECT_TRUE(test::gltf_is_valid(dir / "anim.glb"));
-  const Scene scene = read_scene(dir / "anim.glb");
+  const Scene scene = test::written_animation(dir, female(), lowered_arms(path), r, o);
   const int body = scene.find_node("body");
   ASSERT_GE(body, 0);
   const Mesh& mesh = scene.meshes[static_cast<size_t>(scene.nodes[static_cast<size_t>(body)].mesh)];

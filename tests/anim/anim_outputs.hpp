@@ -1,0 +1,23 @@
+#pragma once
+// Shared by the animation tests: an animation's outputs written without a video, anim.glb checked
+// by the Khronos validator and read back.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "drape/animate.hpp"
+#include "support/gltf_validator.hpp"
+
+namespace drape::test {
+
+// Writes dir's outputs and returns anim.glb's scene (EXPECTs it valid).
+inline Scene written_animation(const std::filesystem::path& dir, const Body& body, const Motion& motion,
+                               const AnimationResult& r, const AnimateOptions& o) {
+  AnimationOutputOptions out;
+  out.video = false;
+  write_animation_outputs(dir, body, motion, r, o, out);
+  EXPECT_TRUE(gltf_is_valid(dir / "anim.glb"));
+  return read_scene(dir / "anim.glb");
+}
+
+}  // namespace drape::test

@@ -12,19 +12,15 @@
 #include <omp.h>
 
 #include "drape/animate.hpp"
-#include "anim_outputs.hpp"
+#include "anim_test_support.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
 namespace {
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
-
-const Body& female() {
-  static const Body body = default_body(Sex::Female);
-  return body;
-}
+using test::female;
+using test::sanitized;
 
 // The shirt at a coarser grid than the paper's (about 700 vertices), so a test runs in seconds.
 AnimateOptions quick_options(long last_frame) {

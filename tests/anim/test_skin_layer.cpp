@@ -13,19 +13,15 @@
 
 #include "drape/animate.hpp"
 #include "drape/skin_layer.hpp"
-#include "anim_outputs.hpp"
+#include "anim_test_support.hpp"
 #include "support/gltf_validator.hpp"
 #include "support/test_support.hpp"
 
 namespace drape {
 namespace {
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
-
-const Body& female() {
-  static const Body body = default_body(Sex::Female);
-  return body;
-}
+using test::female;
+using test::sanitized;
 
 // The arms-raise clip with both arms taken 15 degrees further down at every frame: where the clip
 // lowers them alongside the body (its last frames), linear blend skinning drives the hands into the

@@ -1,14 +1,24 @@
 #pragma once
-// Shared by the animation tests: an animation's outputs written without a video, anim.glb checked
-// by the Khronos validator and read back.
+// Shared by the animation tests: the default female body, whether the build is sanitized, and an
+// animation's outputs written without a video, anim.glb checked by the Khronos validator and read back.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 
 #include "drape/animate.hpp"
+#include "drape/body.hpp"
 #include "support/gltf_validator.hpp"
 
 namespace drape::test {
+
+// The sanitizer build (DRAPE_SANITIZED set) skips the long motions.
+inline bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+
+inline const Body& female() {
+  static const Body body = default_body(Sex::Female);
+  return body;
+}
 
 // Writes dir's outputs and returns anim.glb's scene (EXPECTs it valid).
 inline Scene written_animation(const std::filesystem::path& dir, const Body& body, const Motion& motion,

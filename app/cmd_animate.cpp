@@ -197,8 +197,8 @@ void add_animate_command(CLI::App& app) {
                 "meet, with room for the cloth between (docs/soft-body.md)");
   cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame")->capture_default_str()->check(CLI::Range(1, 64));
   cmd->add_option("--friction", args->friction,
-                  "friction between the cloth and the moving skin (Coulomb coefficient; negative: the fabric's; "
-                  "docs/animation.md says why it is 0 by default)")
+                  "friction between the cloth and the moving skin, which carries the cloth along with the body "
+                  "(Coulomb coefficient; negative: the fabric's)")
       ->capture_default_str()->check(CLI::Range(-1.0, 2.0));
   cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->check(CLI::Range(0, 1024));
   cmd->add_flag("--no-video", args->no_video, "write no video (anim.mp4 or frames/)");

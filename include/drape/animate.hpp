@@ -30,9 +30,9 @@ struct AnimateOptions {
   // More steps in a frame where the body moves fast: enough that 95 % of the body's vertices move at
   // most this far in one step (m), so the cloth is not passed through (a run: 8 steps a frame).
   float max_body_step = 0.015f;
-  // Coulomb coefficient between cloth and the moving skin; negative: the fabric's. 0 by default:
-  // with the fabric's friction the solver dragged the shirt into the walking body (docs/animation.md).
-  float friction = 0.0f;
+  // Coulomb coefficient between cloth and the moving skin, which carries the cloth along with the
+  // body; negative (the default): the fabric's.
+  float friction = -1.0f;
   // Gates every frame must pass (docs/animation.md): at most 1 % of the garment vertices inside the
   // body, strain at most the fabric's threshold + 2 %, seams within 5 mm, nothing below the floor,
   // no garment sliding off (its centre 15 cm lower against the hips than when dressed), no NaN.

@@ -284,7 +284,7 @@ struct ImplicitSolver::Impl {
   void analyse_pattern();
   // Contact planes refreshed where needed (see detect_contacts), and friction's normal forces.
   void detect_contacts(std::span<Collider* const> colliders, const ImplicitSettings& s, double h, bool refresh_all);
-  void lag_friction(const ImplicitSettings& s);
+  void lag_friction(const ImplicitSettings& s, bool at_step_start = false);
   // The largest |mu N - lagged mu N| / (m g) over the particles, N the normal force at x.
   double friction_lag_error(const ImplicitSettings& s) const;
   bool exact = false;  // this iteration's springs: exact Hessian blocks (else projected)
@@ -541,10 +541,19 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
   });
 }
 
-void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s) {
+void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s, bool at_step_start) {
   const double mu = std::max(0.0f, s.friction);
-  for (size_t i = 0; i < n; ++i)
-    friction_force[i] = in_range[i] ? mu * contact_force(contact_k[i], depth(i, x[i])) : 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    // At a step's start the planes are the colliders' at the step's end: a surface that moves
+    // towards the cloth is found up to its whole displacement over the step deeper than it was.
+    // The normal force friction is bounded by is the one at the start, where the surface was: from
+    // the depth there, the displacement along the normal taken off (a walking body's 1.5 cm a step
+    // would otherwise give friction a thousand times the particle's weight, and hold the cloth to
+    // where the body dragged it).
+    double d = depth(i, x[i]);
+    if (at_step_start) d -= plane_normal[i].dot(surface_velocity[i]);
+    friction_force[i] = in_range[i] ? mu * contact_force(contact_k[i], d) : 0.0;
+  }
 }
 
 double ImplicitSolver::Impl::friction_lag_error(const ImplicitSettings& s) const {
@@ -966,7 +975,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   // that move have every plane found anew at the start of each step.
   w.detect_contacts(colliders, s, h, !w.planes_valid || s.moving_colliders);
   w.planes_valid = true;
-  w.lag_friction(s);
+  w.lag_friction(s, true);
   const bool held = state.friction_slip.size() == w.n;
   for (size_t i = 0; i < w.n; ++i) w.held_slip[i] = held ? Vec3d(state.friction_slip[i].cast<double>()) : Vec3d::Zero();
   // Quasi-static: the inertia term becomes a Levenberg-Marquardt damping m_i / (2 h_d^2) |x - x_k|^2

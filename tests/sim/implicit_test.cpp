@@ -223,6 +223,108 @@ TEST(ImplicitSolver, StaticFrictionHoldsFromOneStepToTheNext) {
   EXPECT_LE(stats.residual, 0.01f);
 }
 
+// A square of cotton lying on a plane through the origin with the given normal, at rest against it
+// (its thickness from the plane), moving with the plane's velocity; dynamic steps of a walking
+// body's (1/90 s), contacts found anew every step as in motion.
+struct ClothOnAMovingPlane {
+  ClothModel model;
+  ClothState state;
+  PlaneCollider plane;
+  ImplicitSolver solver;
+  ImplicitSettings settings;
+  ClothOnAMovingPlane(const Vec3f& normal, const Vec3f& plane_velocity, const Vec3f& cloth_velocity)
+      : model([&] {
+          GridClothOptions o;
+          o.nx = o.ny = 11;
+          o.width = o.height = 0.2f;
+          // Two edges of the square in the plane, the cloth resting its thickness above it.
+          const Vec3f u = normal.unitOrthogonal(), v = normal.cross(u);
+          o.u_axis = u;
+          o.v_axis = v;
+          const Fabric cotton = fabric_or_throw("cotton");
+          o.origin = -0.1f * (u + v) + cotton.collision_thickness * normal;
+          return grid_cloth(cotton, o);
+        }()),
+        state(initial_state(model)),
+        plane(Vec3f::Zero(), normal),
+        solver(model, 1),
+        settings([&] {
+          ImplicitSettings s = default_implicit_settings(model);
+          s.time_step = 1.0 / 90.0;
+          s.moving_colliders = true;
+          return s;
+        }()) {
+    plane.set_velocity(plane_velocity);
+    for (Vec3f& v : state.v) v = cloth_velocity;
+  }
+  // Steps for `seconds`; false when a step fails.
+  bool run(double seconds) {
+    Collider* colliders[] = {&plane};
+    const int steps = static_cast<int>(std::lround(seconds / settings.time_step));
+    for (int k = 0; k < steps; ++k)
+      if (solver.step(state, colliders, settings) != StepStatus::Ok) return false;
+    return true;
+  }
+  Vec3f mean(const std::vector<Vec3f>& values) const {
+    Vec3f sum = Vec3f::Zero();
+    for (const Vec3f& v : values) sum += v;
+    return sum / static_cast<float>(values.size());
+  }
+};
+
+// Friction carries cloth along with a surface that moves under it (a body in motion): cotton at
+// rest on a floor that starts sliding at 0.3 m/s is dragged up to the floor's speed by kinetic
+// friction (mu g = 2.9 m/s^2: within 0.1 s) and then carried with it, neither stretched nor pushed
+// into it.
+TEST(ImplicitSolver, FrictionCarriesClothAlongWithASurfaceThatMoves) {
+  ClothOnAMovingPlane c(Vec3f(0, 1, 0), Vec3f(0.3f, 0, 0), Vec3f::Zero());
+  ASSERT_GT(c.settings.friction, 0.0f);
+  ASSERT_TRUE(c.run(0.5));
+  const Vec3f v = c.mean(c.state.v);
+  EXPECT_NEAR(v.x(), 0.3f, 0.015f);
+  EXPECT_NEAR(v.y(), 0.0f, 0.01f);
+  EXPECT_NEAR(v.z(), 0.0f, 0.01f);
+  // Where the floor carried it: 0.15 m less what it slid while it was being dragged up to speed
+  // (0.3^2 / (2 mu g) = 1.5 cm).
+  EXPECT_NEAR(c.mean(c.state.x).x(), 0.15f - 0.015f, 0.005f);
+  float closest = 1e9f;
+  for (const Vec3f& p : c.state.x) closest = std::min(closest, c.plane.signed_distance(p, nullptr));
+  EXPECT_GT(closest, 0.0f);
+  EXPECT_LT(strain_stats(c.model, c.state.x).max, 0.005f);
+}
+
+// Friction is bounded by the normal force where the surface was at a step's start. A slope of 30
+// degrees (steeper than cotton's friction holds: tan 30 = 0.58 > 0.3) rises along its normal at
+// 1.35 m/s, a walking body's 1.5 cm a step, carrying the cloth lying on it at that speed. Nothing
+// presses harder than the cloth's weight, so it slides down the slope as on one that stands still:
+// g (sin 30 - mu cos 30) = 2.4 m/s^2 along it. (Bounded by the depth found against where the surface
+// would be at the step's end, 1.5 cm into it, friction took the normal force as a thousand times
+// the weight and held the cloth where it was.)
+TEST(ImplicitSolver, FrictionOnASurfaceMovingTowardsTheClothIsBoundedByItsWeight) {
+  const float angle = static_cast<float>(M_PI) / 6.0f;
+  const Vec3f normal(-std::sin(angle), std::cos(angle), 0.0f);  // the slope descends towards -x
+  const Vec3f velocity = 1.35f * normal;
+  ClothOnAMovingPlane c(normal, velocity, velocity);
+  // As in a walk's steps, Newton stops at its cap of 12 iterations before the step converges, so
+  // what friction took at the step's start is what it holds with (a step that converges takes the
+  // normal forces again where the cloth is then).
+  c.settings.max_newton_iterations = 12;
+  c.settings.force_tolerance = 0.0;
+  const float mu = c.settings.friction;
+  ASSERT_LT(mu, std::tan(angle));
+  const Vec3f start = c.mean(c.state.x);
+  const double seconds = 0.3;
+  ASSERT_TRUE(c.run(seconds));
+  // How far it slid down the slope, the plane's motion taken off.
+  const Vec3f down_slope(-std::cos(angle), -std::sin(angle), 0.0f);
+  const Vec3f moved = c.mean(c.state.x) - start - velocity * static_cast<float>(seconds);
+  const float along = moved.dot(down_slope);
+  const float expected = 0.5f * 9.81f * (std::sin(angle) - mu * std::cos(angle)) * static_cast<float>(seconds * seconds);
+  EXPECT_GT(along, 0.7f * expected);
+  EXPECT_LT(along, 1.3f * expected);
+  EXPECT_NEAR(moved.dot(normal), 0.0f, 0.002f) << "the cloth rides on the slope, neither into it nor off it";
+}
+
 // The colliders' forces on the cloth (ImplicitSolver::contact_forces), what a body that gives way
 // takes the reaction of: cloth at rest on a sphere is held up by them, so they carry its weight,
 // act at the sphere's surface, and handed to the sphere's vertices (add_pressure) they are equal

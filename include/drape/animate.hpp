@@ -27,8 +27,9 @@ struct AnimateOptions {
   DressOptions dress;                                // how the garments are dressed on the bind pose first
   CollisionMethod collision = CollisionMethod::bvh;  // the moving body's collider
   int substeps = 3;                                  // implicit solver steps per frame, at least
-  // More steps in a frame where the body moves fast: enough that 95 % of the body's vertices move at
-  // most this far in one step (m), so the cloth is not passed through (a run: 8 steps a frame).
+  // More steps in a frame where the body moves fast: enough that 95 % of the body's vertices near
+  // the garments move at most this far in one step (m), so the cloth is not passed through (a run:
+  // 8-9 steps a frame).
   float max_body_step = 0.015f;
   // Coulomb coefficient between cloth and the moving skin, which carries the cloth along with the
   // body; negative (the default): the fabric's.

@@ -115,6 +115,7 @@ struct AnimationResult {
   ImplicitProfile profile;
   double time_step = 0;                    // s, the longest solver step
   uint64_t solver_steps = 0;               // over all frames (per garment)
+  std::vector<float> friction;             // per garment: its Coulomb coefficient against the moving body
   std::optional<AnimatedSoftBody> soft_body;  // with DressOptions::soft_body
   std::optional<AnimatedSkinLayer> skin_layer;  // with AnimateOptions::skin_layer
   bool passed() const { return all_passed(gates); }

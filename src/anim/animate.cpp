@@ -366,6 +366,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // iterations its penalty took the shirt walking over the skirt past the strain gate, and cost
     // the walking shirt 15 % of its frames per wall second.
     settings.push_back(is);
+    r.friction.push_back(is.friction);
     start_offset.push_back(centre_height(g.state.x) - hips_height(0));
   }
   // Per garment: the body, then the garments beneath it, following their particles.

@@ -249,9 +249,12 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                      {"neck_bend_deg", a.limits.max_neck_bend_deg},
                      {"violations", a.limits.violations}}}};
   nlohmann::ordered_json garments = nlohmann::ordered_json::array();
-  for (const DressedGarment& g : r.dressed.garments)
+  for (size_t i = 0; i < r.dressed.garments.size(); ++i) {
+    const DressedGarment& g = r.dressed.garments[i];
     garments.push_back({{"name", g.name}, {"size", g.size}, {"fabric", g.fabric}, {"vertices", g.model.particle_count()},
                         {"strain_threshold", g.model.fabric.strain_threshold}});
+    if (i < r.friction.size()) garments.back()["friction"] = r.friction[i];
+  }
   j["garments"] = garments;
   j["dressing"] = {{"passed", r.dressed.passed()}, {"quality", quality_json(r.dressed.quality)}};
   if (r.soft_body) {

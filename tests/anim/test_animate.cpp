@@ -228,6 +228,9 @@ TEST(AnimateCli, WritesItsOutputs) {
   EXPECT_TRUE(j["simulation"].contains("wall_seconds"));
   EXPECT_EQ(j["motion"]["skeleton"], "cmu");
   EXPECT_EQ(j["gates"]["passed"].get<bool>(), res.exit_code == 0);
+  // Friction carries the shirt along with the body: cotton's coefficient unless asked otherwise.
+  ASSERT_EQ(j["garments"].size(), 1u);
+  EXPECT_FLOAT_EQ(j["garments"][0]["friction"].get<float>(), fabric_or_throw("cotton").friction);
   // The animation reads back: skinned body, its animation, the shirt's frames as morph targets.
   const Scene s = read_scene(dir / "anim.glb");
   ASSERT_EQ(s.animations.size(), 1u);

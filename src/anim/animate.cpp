@@ -20,6 +20,7 @@
 #include "drape/animate.hpp"
 #include "drape/error.hpp"
 #include "drape/fit_map.hpp"
+#include "geometry/vertex_grid.hpp"
 
 namespace drape {
 namespace {
@@ -28,32 +29,21 @@ using Clock = std::chrono::steady_clock;
 constexpr int kMaxStepsPerFrame = 32;
 
 // How far the body moves near a garment over a frame: the 95th percentile of the travel of the
-// body's vertices in the cells of a kNearCloth grid round the garment's particles (at the frame's
-// start) and the cells next to them. Parts away from the cloth (a walk's hands swinging below a
-// shirt's short sleeves, its feet under a skirt) do not ask for more steps. The travel is the
-// vertices' own, not against the cloth's: a step's Newton iterations start where the cloth was,
-// with contacts found against where the body will be (measured against the garment's mean motion
-// instead, the run took 3 steps a frame and left the shirt behind, a third of it inside the body).
-// `cells` and `moved` are scratch.
+// body's vertices that `grid` (the body at the frame's start, kNearCloth cells) finds round the
+// garment's particles. Parts away from the cloth (a walk's hands swinging below a shirt's short
+// sleeves, its feet under a skirt) do not ask for more steps. The travel is the vertices' own, not
+// against the cloth's: a step's Newton iterations start where the cloth was, with contacts found
+// against where the body will be (measured against the garment's mean motion instead, the run took
+// 3 steps a frame and left the shirt behind, a third of it inside the body). `near` and `moved`
+// are scratch, one entry per body vertex.
 constexpr float kNearCloth = 0.05f;  // m
-float travel_near(std::span<const Vec3f> from, std::span<const Vec3f> to, const ClothState& cloth,
-                  std::vector<uint64_t>& cells, std::vector<float>& moved) {
-  const auto cell_of = [](const Vec3f& p, int dx, int dy, int dz) {
-    const auto c = [](float x, int d) { return static_cast<uint64_t>(static_cast<int64_t>(std::floor(x / kNearCloth)) + d + (1 << 20)) & 0x1fffff; };
-    return c(p.x(), dx) << 42 | c(p.y(), dy) << 21 | c(p.z(), dz);
-  };
-  cells.clear();
-  for (const Vec3f& p : cloth.x) cells.push_back(cell_of(p, 0, 0, 0));
-  std::sort(cells.begin(), cells.end());
-  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+float travel_near(const VertexGrid& grid, std::span<const Vec3f> from, std::span<const Vec3f> to, const ClothState& cloth,
+                  std::vector<uint8_t>& near, std::vector<float>& moved) {
+  std::fill(near.begin(), near.end(), uint8_t{0});
+  for (const Vec3f& p : cloth.x) grid.near(p, [&](uint32_t v) { near[v] = 1; });
   size_t count = 0;
-  for (size_t v = 0; v < from.size(); ++v) {
-    bool near = false;
-    for (int dx = -1; dx <= 1 && !near; ++dx)
-      for (int dy = -1; dy <= 1 && !near; ++dy)
-        for (int dz = -1; dz <= 1 && !near; ++dz) near = std::binary_search(cells.begin(), cells.end(), cell_of(from[v], dx, dy, dz));
-    if (near) moved[count++] = (to[v] - from[v]).norm();
-  }
+  for (size_t v = 0; v < from.size(); ++v)
+    if (near[v]) moved[count++] = (to[v] - from[v]).norm();
   if (count == 0) return 0.0f;
   const size_t p95 = std::min(count - 1, static_cast<size_t>(0.95 * static_cast<double>(count)));
   std::nth_element(moved.begin(), moved.begin() + static_cast<long>(p95), moved.begin() + static_cast<long>(count));
@@ -428,7 +418,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   // The skin layer of frames skinned before the loop counts with the skinning.
   r.simulation_seconds = r.skinning_seconds + (r.skin_layer && !soft ? r.skin_layer->seconds : 0.0);
   std::vector<float> moved(body.mesh.vertex_count());
-  std::vector<uint64_t> near_cells;
+  std::vector<uint8_t> near(body.mesh.vertex_count());
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
     if (soft) {
@@ -440,7 +430,8 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // most max_body_step. Over all the body's vertices (its hands and feet swing farthest), the
     // walk took 6.3 steps a frame at 1.5 cm a step where it now takes 4.9 at 1.2 cm (docs/animation.md).
     float travel = 0;
-    for (size_t g = 0; g < ng; ++g) travel = std::max(travel, travel_near(skin[f - 1], skin[f], states[g], near_cells, moved));
+    const VertexGrid grid(skin[f - 1], kNearCloth);
+    for (size_t g = 0; g < ng; ++g) travel = std::max(travel, travel_near(grid, skin[f - 1], skin[f], states[g], near, moved));
     const int steps = std::clamp(static_cast<int>(std::ceil(travel / std::max(o.max_body_step, 1e-4f))), o.substeps, kMaxStepsPerFrame);
     bool converged = true;
     float residual = 0;

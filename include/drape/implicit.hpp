@@ -86,7 +86,7 @@ struct ImplicitProfile {
   double contacts = 0, assemble = 0, factorize = 0, solve = 0, line_search = 0;
   double self_contacts = 0;  // finding the self-contact pairs
   uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
-  uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration, one after a factorisation
+  uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration and one to start them
   double total_seconds() const { return contacts + self_contacts + assemble + factorize + solve + line_search; }
 };
 

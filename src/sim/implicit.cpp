@@ -263,7 +263,6 @@ struct ImplicitSolver::Impl {
   static constexpr size_t kReducedFrom = 4000;
   bool whole_stencils = false;
   uint32_t fresh_attempts = 0, fresh_misses = 0;
-  bool indefinite = false;  // the last conjugate gradients met a direction of non-positive curvature
   std::vector<std::array<uint32_t, 2>> far_pair;
   std::vector<double> far_coefficient;  // b per far pair
   std::vector<double> far_diag;         // per particle: sum of |b| over its far pairs
@@ -309,7 +308,10 @@ struct ImplicitSolver::Impl {
   bool factored = false;
   bool planes_valid = false;  // contact planes found at least once  // the factorisation holds a matrix of this step
   Eigen::VectorXd residual_vec, search, product, preconditioned;  // conjugate gradients
-  bool preconditioned_solve(double tolerance, int iterations);
+  // Conjugate gradients from zero into `direction`: they reach the tolerance, run out of
+  // iterations, or meet a direction of non-positive curvature (the iterate before it is kept).
+  enum class Solve : uint8_t { Reached, Missed, Indefinite };
+  Solve preconditioned_solve(double tolerance, int iterations);
   uint64_t triangular_solves = 0;  // since construction
   // out = A^-1 rhs with the current factorisation (under the BLAS lock).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
@@ -903,7 +905,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
   if (self_valid) add_self_hessian(values);
 }
 
-bool ImplicitSolver::Impl::preconditioned_solve(double tolerance, int iterations) {
+ImplicitSolver::Impl::Solve ImplicitSolver::Impl::preconditioned_solve(double tolerance, int iterations) {
   Eigen::VectorXd& d = direction;
   Eigen::VectorXd& r = residual_vec;
   d.setZero();
@@ -912,24 +914,20 @@ bool ImplicitSolver::Impl::preconditioned_solve(double tolerance, int iterations
   solve(r, preconditioned);
   search = preconditioned;
   double rz = r.dot(preconditioned);
-  indefinite = false;
   for (int k = 0; k < iterations; ++k) {
     hessian_product(search, product);
     const double curvature = search.dot(product);
-    if (!(curvature > 0)) {
-      indefinite = true;
-      return false;
-    }
+    if (!(curvature > 0)) return Solve::Indefinite;
     const double step = rz / curvature;
     d += step * search;
     r -= step * product;
-    if (r.norm() <= target) return true;
+    if (r.norm() <= target) return Solve::Reached;
     solve(r, preconditioned);
     const double rz_next = r.dot(preconditioned);
     search = preconditioned + (rz_next / rz) * search;
     rz = rz_next;
   }
-  return false;
+  return Solve::Missed;
 }
 
 float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
@@ -1099,7 +1097,8 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     // matrix enough for one miss, the next attempt mostly misses too (a walk's steps: every
     // attempt). A loose one is reached in a few iterations far more often: the walk took 1.9x fewer
     // factorisations and 1.4x less time with 0.5 (docs/animation.md).
-    const bool solved = w.factored && !cg_missed && w.preconditioned_solve(s.direction_tolerance, s.direction_iterations);
+    const bool solved = w.factored && !cg_missed &&
+                        w.preconditioned_solve(s.direction_tolerance, s.direction_iterations) == Impl::Solve::Reached;
     cg_missed = s.direction_tolerance < ImplicitSettings::kLooseDirection && (cg_missed || (w.factored && !solved));
     timer.mark(profile ? profile->solve : scratch_time);
     if (!solved) {
@@ -1124,12 +1123,12 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
         w.residual_vec = -w.gradient;
         w.solve(w.residual_vec, w.direction);
       } else {
-        const bool reached = w.preconditioned_solve(s.direction_tolerance, s.direction_iterations);
+        const Impl::Solve result = w.preconditioned_solve(s.direction_tolerance, s.direction_iterations);
         // The Hessian not positive definite along P's direction (the exact one where the cloth
         // buckles): that direction, a descent direction since P is.
-        if (!reached && w.direction.squaredNorm() == 0) w.direction = w.search;
+        if (result != Impl::Solve::Reached && w.direction.squaredNorm() == 0) w.direction = w.search;
         ++w.fresh_attempts;
-        if (!reached && !w.indefinite) ++w.fresh_misses;
+        if (result == Impl::Solve::Missed) ++w.fresh_misses;
         if (w.fresh_misses >= Impl::kFreshMisses && 4 * w.fresh_misses > w.fresh_attempts) {
           w.whole_stencils = true;
           w.analyse_pattern();  // the next iteration factorises the whole Hessian

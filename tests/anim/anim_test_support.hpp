@@ -9,11 +9,11 @@
 #include "drape/animate.hpp"
 #include "drape/body.hpp"
 #include "support/gltf_validator.hpp"
+#include "support/test_support.hpp"
 
 namespace drape::test {
 
 // The sanitizer build (DRAPE_SANITIZED set) skips the long motions.
-inline bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
 
 inline const Body& female() {
   static const Body body = default_body(Sex::Female);

@@ -17,6 +17,7 @@
 #include "drape/body.hpp"
 #include "drape/error.hpp"
 #include "drape/io.hpp"
+#include "body/body_test_support.hpp"
 #include "support/test_support.hpp"
 
 using namespace drape;
@@ -30,14 +31,9 @@ using namespace drape;
 
 namespace {
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+using test::sanitized;
 
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (const Tri& t : m.triangles)
-    v += m.positions[t[0]].cast<double>().dot(m.positions[t[1]].cast<double>().cross(m.positions[t[2]].cast<double>())) / 6.0;
-  return v;
-}
+using test::signed_volume;
 
 struct Size {
   const char* name;

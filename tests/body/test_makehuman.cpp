@@ -17,6 +17,7 @@
 #include "body/surface_nets.hpp"
 #include "drape/body.hpp"
 #include "drape/error.hpp"
+#include "body/body_test_support.hpp"
 #include "support/test_support.hpp"
 
 using namespace drape;
@@ -29,7 +30,7 @@ namespace {
     GTEST_SKIP() << "shared test data not found: " << (rel) << " (needs ../shared/data)"; \
   }
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+using test::sanitized;
 
 body::MhShape shape(Sex sex, float weight, float height = 0.5f) {
   body::MhShape s;
@@ -93,12 +94,7 @@ size_t self_intersections(const Mesh& m) {
   return crossings;
 }
 
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (const Tri& t : m.triangles)
-    v += m.positions[t[0]].cast<double>().dot(m.positions[t[1]].cast<double>().cross(m.positions[t[2]].cast<double>())) / 6.0;
-  return v;
-}
+using test::signed_volume;
 
 float value_of(const Measurements& m, std::string_view key) {
   for (const auto& row : measurement_table())

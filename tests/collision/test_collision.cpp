@@ -11,6 +11,7 @@
 
 #include "collision/shapes.hpp"
 #include "drape/collision.hpp"
+#include "support/test_support.hpp"
 
 namespace drape {
 namespace {
@@ -18,7 +19,7 @@ namespace {
 constexpr float kDegree = std::numbers::pi_v<float> / 180.0f;
 const float kInfinity = std::numeric_limits<float>::infinity();
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+using test::sanitized;
 
 // A narrower distance-field band than the default keeps the field builds quick in tests.
 BodyColliderOptions test_options() {

@@ -5,10 +5,10 @@
 #include <string>
 
 #include "drape/dress.hpp"
+#include "support/test_support.hpp"
 
 namespace drape::test {
 
-inline bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
 
 // Bodies are expensive to build: one of each per test program, made on first use (thread-safe
 // statics, one per sex and per `make`).

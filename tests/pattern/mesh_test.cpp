@@ -7,6 +7,7 @@
 #include <set>
 
 #include "drape/garment.hpp"
+#include "support/test_support.hpp"
 
 namespace drape {
 namespace {
@@ -20,7 +21,7 @@ double mesh_area(const Mesh& m) {
   return a;
 }
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+using test::sanitized;
 
 // Arc-length fraction of a boundary vertex along its seam side.
 double side_fraction(const Garment& g, const PanelMesh& pm, const SeamSide& side, uint32_t vertex, bool at_end) {

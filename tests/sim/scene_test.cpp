@@ -15,7 +15,7 @@
 namespace drape {
 namespace {
 
-bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
+using test::sanitized;
 
 ClothSceneOptions sphere_scene(StrainLimit limit) {
   ClothSceneOptions o;

@@ -1,12 +1,17 @@
 #pragma once
 // Helpers shared by all test executables: where the real-data fixtures and the CLI are,
 // and running the CLI as a user would.
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 namespace drape::test {
+
+// Whether the tests run under the sanitizers (DRAPE_SANITIZED, set by `make sanitize`): long scenes
+// are cut short or skipped there.
+inline bool sanitized() { return std::getenv("DRAPE_SANITIZED") != nullptr; }
 
 // ../shared/data (absolute), or an empty path when it is absent (a user's fresh clone).
 std::filesystem::path shared_data();

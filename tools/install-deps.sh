@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  cmake make g++ pkg-config git ca-certificates
+  cmake make g++ lld pkg-config git ca-certificates
   clang-14 libclang-rt-14-dev clang-format clang-tidy   # fuzzing (libFuzzer) and the style configs
   libeigen3-dev libsuitesparse-dev nlohmann-json3-dev libfmt-dev libcli11-dev
   libopenblas0-pthread                                  # CHOLMOD's dense kernels: 3x the reference BLAS

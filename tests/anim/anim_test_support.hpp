@@ -13,8 +13,6 @@
 
 namespace drape::test {
 
-// The sanitizer build (DRAPE_SANITIZED set) skips the long motions.
-
 inline const Body& female() {
   static const Body body = default_body(Sex::Female);
   return body;

@@ -9,7 +9,6 @@
 
 namespace drape::test {
 
-
 // Bodies are expensive to build: one of each per test program, made on first use (thread-safe
 // statics, one per sex and per `make`).
 template <class Make>

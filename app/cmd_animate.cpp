@@ -32,8 +32,7 @@ struct AnimateArgs {
   std::string motion_up = "auto";
   std::string skinning = "linear";
   std::string collision = "bvh";
-  std::string dress_solver = "explicit";
-  bool dress_solver_given = false;
+  std::string dress_solver = "implicit";
   bool soft_body = false;
   bool skin_layer = false;
   int substeps = 3;
@@ -68,12 +67,11 @@ void run_animate(const AnimateArgs& a) {
   o.collision = *parse_collision_method(a.collision);
   o.substeps = a.substeps;
   o.friction = a.friction;
-  o.dress.solver = a.dress_solver == "implicit" ? Solver::Implicit : Solver::Explicit;
+  o.dress.solver = a.dress_solver == "explicit" ? Solver::Explicit : Solver::Implicit;
   if (a.soft_body) {
     // The body gives way under the implicit solver's contact forces: dressed with it too.
-    if (a.dress_solver_given && o.dress.solver != Solver::Implicit)
+    if (o.dress.solver != Solver::Implicit)
       throw InputError("--soft-body", "needs the implicit dressing (--dress-solver implicit)");
-    o.dress.solver = Solver::Implicit;
     o.dress.soft_body = true;
   }
   o.skin_layer = a.skin_layer;
@@ -204,10 +202,7 @@ void add_animate_command(CLI::App& app) {
   cmd->add_flag("--no-video", args->no_video, "write no video (anim.mp4 or frames/)");
   cmd->add_option("--out", args->out, "output directory")->capture_default_str();
   add_load_options(*cmd, args->load);
-  cmd->callback([args, cmd] {
-    args->dress_solver_given = cmd->get_option("--dress-solver")->count() > 0;
-    run_animate(*args);
-  });
+  cmd->callback([args] { run_animate(*args); });
 }
 
 }  // namespace drape::app

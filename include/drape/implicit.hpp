@@ -42,6 +42,9 @@ struct ImplicitSettings {
   bool moving_colliders = false;        // colliders move or deform: every contact found anew each step
   Vec3f gravity{0.0f, -9.81f, 0.0f};    // m/s^2
   float friction = 0.3f;                // Coulomb coefficient against colliders
+  // Friction's static range (m): tangential slip from where friction holds a particle is resisted
+  // like a spring up to this, by the whole Coulomb force beyond it.
+  double friction_slip = 1e-4;
   float strain_threshold = 0.05f;       // structural stretch at which the limit's barrier starts
   float seam_stiffness = 2000.0f;       // N/m per sewn pair (a closed seam's zero-length spring)
   float seam_force = 0.0f;              // N, the most one pair pulls with (sewing); 0: no cap

@@ -59,13 +59,13 @@ inline double contact_energy(double k, double d) {
 }
 inline double contact_force(double k, double d) { return d > 0 ? k * d * (1.0 + 0.5 * d / kContactStiffening) : 0.0; }
 inline double contact_stiffness(double k, double d) { return d > 0 ? k * (1.0 + d / kContactStiffening) : 0.0; }
-// Friction's smoothing (IPC): tangential slip below this is resisted like a stiff spring (static
-// friction), above it by the full Coulomb force. The slip is measured from where friction holds the
-// particle, which is carried from step to step (ClothState::friction_slip): a step's end that
-// friction holds stays held at the next step's start. Measured from each step's start instead,
-// every step began with the static friction of the last one let go, off balance by up to mu N
-// (at rest on the body: 20x a particle's weight), and spent iterations finding it again.
-constexpr double kFrictionSlip = 1e-4;  // m
+// Friction's smoothing (IPC, ImplicitSettings::friction_slip): tangential slip below it is resisted
+// like a stiff spring (static friction), above it by the full Coulomb force. The slip is measured
+// from where friction holds the particle, which is carried from step to step
+// (ClothState::friction_slip): a step's end that friction holds stays held at the next step's
+// start. Measured from each step's start instead, every step began with the static friction of the
+// last one let go, off balance by up to mu N (at rest on the body: 20x a particle's weight), and
+// spent iterations finding it again.
 // A contact plane is found anew once its particle moved this far from where it was found.
 constexpr double kReplane = 1e-3;  // m
 // A contact plane found anew whose normal is more than 90 degrees from the last one's is another
@@ -86,12 +86,16 @@ constexpr double kSelfRefind = 5e-3;  // m
 // Newton also stops when an iteration moved no particle more than this (ImplicitSettings has the
 // force tolerance).
 constexpr double kStagnation = 1e-8;  // m
-// Friction's normal forces are lagged (taken where the step starts); once Newton has converged with
-// them, they are taken again where the contacts are now and Newton goes on, at most this many times
-// a step. Without it a quasi-static step ends where static friction, bounded by the normal forces
-// of the step's start, balances a contact that has since pressed harder or eased: the state of rest
-// for the start's forces, not the end's, and the next step starts off balance again by the
-// difference (the default shirt's last dozen steps ended 0.04-0.3 of a particle's weight off).
+// Friction's normal forces are lagged (taken where the step starts); once a quasi-static step's
+// Newton has converged with them, they are taken again where the contacts are now and Newton goes
+// on, at most this many times a step. Without it a quasi-static step ends where static friction,
+// bounded by the normal forces of the step's start, balances a contact that has since pressed
+// harder or eased: the state of rest for the start's forces, not the end's, and the next step
+// starts off balance again by the difference (the default shirt's last dozen steps ended 0.04-0.3
+// of a particle's weight off). A dynamic step keeps the start's forces, as IPC's lagged friction
+// does: taken again in a step of a walk, they move the minimum Newton is converging to while the
+// body drags the cloth, and steps solved to their tolerance took 1.6x the Newton iterations
+// (docs/animation.md).
 constexpr int kMaxRelags = 4;
 constexpr int kMaxHalvings = 12;
 constexpr double kMaxDampingStep = 10.0;  // s: the weakest quasi-static damping, m / h_d^2
@@ -336,9 +340,10 @@ struct ImplicitSolver::Impl {
     return model.fabric.collision_thickness - (crease_normal[i].dot(p) + crease_offset[i]);
   }
   // Friction's force on particle i is -friction_scale(i, |u|) u for its slip u: a stiff spring
-  // below kFrictionSlip (static friction), the full Coulomb force above it.
+  // below friction_slip (static friction), the full Coulomb force above it.
+  double friction_slip = 1e-4;  // m, the step's ImplicitSettings::friction_slip
   double friction_scale(size_t i, double slip) const {
-    return slip < kFrictionSlip ? friction_force[i] / kFrictionSlip : friction_force[i] / slip;
+    return slip < friction_slip ? friction_force[i] / friction_slip : friction_force[i] / slip;
   }
   // Particle i's tangential slip at `p` from where friction holds it.
   Vec3d tangential_slip(size_t i, const Vec3d& p) const {
@@ -649,7 +654,7 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       if (in_crease[i]) e += contact_energy(contact_k[i], crease_depth(i, at[i]));
       if (friction_force[i] > 0) {
         const double u = tangential_slip(i, at[i]).norm();
-        e += friction_force[i] * (u < kFrictionSlip ? 0.5 * u * u / kFrictionSlip : u - 0.5 * kFrictionSlip);
+        e += friction_force[i] * (u < friction_slip ? 0.5 * u * u / friction_slip : u - 0.5 * friction_slip);
       }
     }
     block_sum[b] = e;
@@ -875,7 +880,7 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
             // Sliding: the Coulomb force has no stiffness along the slip, only across it (its
             // direction turns with the slip), so Newton lets the particle slide as far as the
             // other forces take it instead of treating friction as a spring.
-            if (slip >= kFrictionSlip) diag += scale * (tangent - (u / slip) * (u / slip).transpose());
+            if (slip >= friction_slip) diag += scale * (tangent - (u / slip) * (u / slip).transpose());
             else diag += scale * tangent;
           }
         }
@@ -1028,6 +1033,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     w.analysed = true;
   }
   ImplicitStepStats st;
+  w.friction_slip = std::max(s.friction_slip, 1e-9);
   w.factored = false;
   w.self_valid = false;
   const double max_move = s.max_move;
@@ -1079,7 +1085,8 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     }
     w.assemble(s, hd);
     timer.mark(profile ? profile->assemble : scratch_time);
-    if (w.force_ratio <= s.force_tolerance && relags < kMaxRelags && w.friction_lag_error(s) > s.force_tolerance) {
+    if (s.quasi_static && w.force_ratio <= s.force_tolerance && relags < kMaxRelags &&
+        w.friction_lag_error(s) > s.force_tolerance) {
       ++relags;
       w.lag_friction(s);
       w.assemble(s, hd);
@@ -1181,7 +1188,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     if (w.in_range[i] && w.friction_force[i] > 0) {
       u = w.tangential_slip(i, w.x[i]);
       const double length = u.norm();
-      if (length > kFrictionSlip) u *= kFrictionSlip / length;
+      if (length > w.friction_slip) u *= w.friction_slip / length;
     }
     state.friction_slip[i] = u.cast<float>();
   }

@@ -157,6 +157,37 @@ class CholmodCall {
   std::unique_lock<std::mutex> hold_;
 };
 
+// CHOLMOD's supernodal factorisation, solving into storage kept from call to call: Eigen's solve()
+// has CHOLMOD allocate the result and its workspace at every call, and copies the result out;
+// cholmod_solve2 reuses them, so a step's triangular solves allocate nothing. The same arithmetic.
+class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+ public:
+  Cholesky() = default;
+  Cholesky(const Cholesky&) = delete;
+  Cholesky& operator=(const Cholesky&) = delete;
+  ~Cholesky() {
+    cholmod_free_dense(&x_, &cholmod());
+    cholmod_free_dense(&y_, &cholmod());
+    cholmod_free_dense(&e_, &cholmod());
+  }
+  // out = A^-1 rhs with the last factorisation (out sized like rhs).
+  void solve_into(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+    cholmod_dense b{};
+    b.nrow = b.nzmax = b.d = static_cast<size_t>(rhs.size());
+    b.ncol = 1;
+    b.x = const_cast<double*>(rhs.data());  // read only
+    b.xtype = CHOLMOD_REAL;
+    b.dtype = CHOLMOD_DOUBLE;
+    if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &b, nullptr, &x_, nullptr, &y_, &e_, &cholmod()))
+      throw std::runtime_error("implicit solver: CHOLMOD could not solve with its factorisation");
+    out.resize(rhs.size());
+    out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x_->x), rhs.size());
+  }
+
+ private:
+  cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // result and workspace
+};
+
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -284,7 +315,7 @@ struct ImplicitSolver::Impl {
   std::vector<Vec3d> bend_gradient;  // per particle, at the iterate
   // sum k/2 |d|^2 over the stencils at `at`, and (with `gradient`) each particle's gradient.
   double bend_terms(const std::vector<Vec3d>& at, bool gradient);
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholesky;
+  Cholesky cholesky;
 
   // Per step and iteration (allocated once).
   std::vector<Vec3d> x, x0, y, trial;     // positions now, at the step start, inertial target, trial
@@ -320,7 +351,7 @@ struct ImplicitSolver::Impl {
   // out = A^-1 rhs with the current factorisation (under the BLAS lock).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
     const CholmodCall call;
-    out = cholesky.solve(rhs);
+    cholesky.solve_into(rhs, out);
     ++triangular_solves;
   }
 

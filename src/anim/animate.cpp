@@ -356,7 +356,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // the cloth by millimetres in a step, and Newton's iterates crossed a 0.1 mm range between
     // static and sliding friction at every iteration: the dress's walk, its steps solved to their
     // tolerance, took 1.6x the Newton iterations it takes without friction, at 1 mm 1.0x. Within
-    // the cap, the four motions of docs/animation.md take 11-16 % fewer factorisations.
+    // the cap, the four motions of docs/animation.md take 10-14 % fewer factorisations.
     is.friction_slip = 1e-3;
     // No self-contact in motion yet (docs/cloth.md, "Self-contact"): within a frame's few Newton
     // iterations its penalty took the shirt walking over the skirt past the strain gate, and cost

@@ -172,15 +172,9 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
   }
   // out = A^-1 rhs with the last factorisation (out sized like rhs).
   void solve_into(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
-    cholmod_dense b{};
-    b.nrow = b.nzmax = b.d = static_cast<size_t>(rhs.size());
-    b.ncol = 1;
-    b.x = const_cast<double*>(rhs.data());  // read only
-    b.xtype = CHOLMOD_REAL;
-    b.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense b = Eigen::viewAsCholmod(const_cast<Eigen::VectorXd&>(rhs));  // read only
     if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &b, nullptr, &x_, nullptr, &y_, &e_, &cholmod()))
       throw std::runtime_error("implicit solver: CHOLMOD could not solve with its factorisation");
-    out.resize(rhs.size());
     out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x_->x), rhs.size());
   }
 

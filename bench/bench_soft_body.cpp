@@ -68,14 +68,16 @@ void cold(benchmark::State& state, const Scene& s) {
 }
 
 void frames(benchmark::State& state, const Scene& s) {
-  std::vector<Vec3f> at = drape::solve_soft_body(s.soft, s.press).positions;
+  // The solver of a motion: its factorisation kept from frame to frame.
+  drape::SoftBodySolver solver(s.soft);
+  std::vector<Vec3f> at = solver.solve(s.press).positions;
   std::vector<Vec3f> press = s.press;
   bool stronger = true;
   double newton = 0, factorisations = 0, count = 0;
   for (auto _ : state) {
     for (size_t v = 0; v < press.size(); ++v) press[v] = (stronger ? 1.1f : 1.0f) * s.press[v];
     stronger = !stronger;
-    drape::SoftSolve solved = drape::solve_soft_body(s.soft, press, at);
+    drape::SoftSolve solved = solver.solve(press, at);
     newton += solved.newton_iterations;
     factorisations += solved.factorisations;
     count += 1;

@@ -22,6 +22,7 @@
 // the minimum of E + membrane + sliding - forces . positions, found by Newton's method (each
 // region's rank-one collective Hessian through Woodbury's identity on the sparse rest, factorised
 // by Eigen's simplicial LDL^T).
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -92,6 +93,24 @@ struct SoftSolve {
 // The body at rest under `forces` (N per body vertex, e.g. the cloth's pressure), Newton's method
 // from `start` (the rest shape when empty). Static vertices keep their rest positions.
 SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, std::span<const Vec3f> start = {});
+
+// The same solve, again and again for one soft body (each frame of a motion, each round of a
+// dressing): the Hessian's sparsity pattern is analysed once, and its last factorisation is kept
+// from one solve to the next while Newton's steps on it go on converging (the body under a press
+// that changes a little from frame to frame: a frame then costs a few triangular solves). `soft`
+// must outlive the solver.
+class SoftBodySolver {
+ public:
+  explicit SoftBodySolver(const SoftBody& soft);
+  ~SoftBodySolver();
+  SoftBodySolver(const SoftBodySolver&) = delete;
+  SoftBodySolver& operator=(const SoftBodySolver&) = delete;
+  SoftSolve solve(std::span<const Vec3f> forces, std::span<const Vec3f> start = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // The regions' volume change and compression for `positions` (every body vertex).
 std::vector<SoftRegionState> soft_region_states(const SoftBody& soft, std::span<const Vec3f> positions);

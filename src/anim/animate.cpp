@@ -106,8 +106,10 @@ Eigen::Matrix3f vertex_rotation(const Vec3f& n0, const Vec3f& e0, const Vec3f& n
 // and the body's rest under the cloth's reaction after each frame.
 class MovingSoftBody {
  public:
+  MovingSoftBody(const MovingSoftBody&) = delete;
+  MovingSoftBody& operator=(const MovingSoftBody&) = delete;
   MovingSoftBody(const Body& body, const SoftBodyResult& dressed, const SoftBodyOptions& options)
-      : bind_(body), soft_(make_soft_body(body, options)), displaced_(dressed.body) {
+      : bind_(body), soft_(make_soft_body(body, options)), solver_(soft_), displaced_(dressed.body) {
     for (size_t v = 0; v < soft_.region_of.size(); ++v)
       if (soft_.region_of[v] >= 0) out.vertices.push_back(static_cast<uint32_t>(v));
     neighbour_.assign(body.mesh.vertex_count(), 0);
@@ -153,7 +155,7 @@ class MovingSoftBody {
                           posed[u] - posed[v]);
       rest_force_[v] = rotation.transpose() * map.force[v];
     }
-    const SoftSolve solved = solve_soft_body(soft_, rest_force_, displaced_.mesh.positions);
+    const SoftSolve solved = solver_.solve(rest_force_, displaced_.mesh.positions);
     displaced_.mesh.positions = solved.positions;
     out.newton_iterations += solved.newton_iterations;
     for (size_t k = 0; k < solved.regions.size() && k < out.worst.size(); ++k) {
@@ -171,6 +173,7 @@ class MovingSoftBody {
  private:
   const Body& bind_;
   SoftBody soft_;
+  SoftBodySolver solver_;          // on soft_, its factorisation kept from frame to frame
   Body displaced_;                 // the bind pose as the body gave way
   std::vector<uint32_t> neighbour_;  // per vertex: one it shares a triangle with
   std::vector<Vec3f> rest_force_;  // per vertex: the cloth's force turned into the bind pose

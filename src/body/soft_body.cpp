@@ -3,6 +3,7 @@
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -22,12 +23,13 @@ using Vec3 = Eigen::Vector3d;
 
 constexpr double kConverged = 1e-5;  // N: the largest force left on a soft vertex
 
-// A spring's Hessian from its length l, rest length L and unit direction u, kept positive
-// semi-definite: k u u^T, plus k (1 - L / l) (I - u u^T) while it is stretched.
-Mat3 spring_hessian(double k, double l, double L, const Vec3& u) {
+// A spring's Hessian from its length l, rest length L and unit direction u: k u u^T + k (1 - L / l)
+// (I - u u^T). Compressed (l < L) the second term is negative, and `compressed` is the share of it
+// kept (0: the block is positive semi-definite on its own).
+Mat3 spring_hessian(double k, double l, double L, const Vec3& u, double compressed = 0.0) {
   const Mat3 uu = u * u.transpose();
   Mat3 h = k * uu;
-  if (l > L && l > 0) h += k * (1.0 - L / l) * (Mat3::Identity() - uu);
+  if (l > 0) h += (l > L ? 1.0 : compressed) * k * (1.0 - L / l) * (Mat3::Identity() - uu);
   return h;
 }
 
@@ -150,21 +152,215 @@ std::vector<SoftRegionState> soft_region_states(const SoftBody& soft, std::span<
   return out;
 }
 
-SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, std::span<const Vec3f> start) {
-  const size_t n = soft.rest.size();
-  SoftSolve out;
-  // Positions in double through the solve: the collective term multiplies a region's summed
-  // length change by a large K, and float positions would leave its force at a few 1e-4 N.
-  std::vector<Vec3> x(n);
-  for (size_t v = 0; v < n; ++v) x[v] = (start.size() == n && soft.region_of[v] >= 0 ? start[v] : soft.rest[v]).cast<double>();
+struct SoftBodySolver::Impl {
+  explicit Impl(const SoftBody& s);
+  SoftSolve solve(std::span<const Vec3f> forces, std::span<const Vec3f> start);
+
+  // The energy at `p` (every body vertex), with each region's dl_tot = sum c_i (l_i - l_i^0).
+  double energy_of(const std::vector<Vec3>& p, std::span<const Vec3f> forces, std::vector<double>& tot) const;
+  // The Hessian's values at x_ (its pattern fixed), factorised, and the Woodbury terms with it.
+  bool factorise();
+
+  struct Edge {
+    uint32_t a, b;       // body vertices
+    int ia, ib;          // their unknowns' blocks, -1 where the vertex stays put
+    double rest;
+    int ab = -1, ba = -1;  // the off-diagonal blocks' slots (both ends soft)
+  };
+
+  const SoftBody& soft;
+  size_t n = 0, m = 0, regions = 0;
+  double K = 0, C = 0, k_membrane = 0, k_shear = 0;
+  std::vector<uint32_t> vertex;  // soft vertices, in the unknowns' order
+  // Per soft vertex (the unknowns' order): its support spring's direction (the rest normal) and
+  // rest length, its frame point, rest position, c_i, region and diagonal block's slot. The spring's
+  // length is measured along its direction: a spring perpendicular to the surface, as the paper has
+  // it, whose energy stays convex however deep the press (measured point to point, a vertex pushed
+  // past its frame point would find the spring's rest length again on the other side).
+  std::vector<Vec3> normal, frame, rest;
+  std::vector<double> rest_length, weight;
+  std::vector<int> region, diagonal;
+  std::vector<Edge> edges;
+
+  // Slot of block (i, j): the position in H's values of its entry (3i, 3j + c) is at[c], the next
+  // two rows following it (the pattern holds whole 3x3 blocks, each column's rows sorted).
+  std::vector<std::array<int, 3>> slots;
+  Eigen::SparseMatrix<double> H;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> cholesky;
+  bool factored = false;
+  // The regions' collective terms K A A^T, A holding one column c_i u_i per region (a rank-one
+  // term each, kept out of the sparse factorisation); H^-1 A and (1/K + A^T H^-1 A)^-1 per
+  // factorisation, for Woodbury's identity.
+  Eigen::MatrixXd A, HA;
+  Eigen::LDLT<Eigen::MatrixXd> small;
+
+  std::vector<Vec3> x, trial;  // every body vertex, in double
+  std::vector<double> dl_tot, trial_tot;
+  std::vector<double> compressed_sum;  // per soft vertex: its compressed springs' negative curvature
+  Eigen::VectorXd gradient, step;
+};
+
+SoftBodySolver::Impl::Impl(const SoftBody& s) : soft(s) {
+  n = soft.rest.size();
+  regions = soft.regions.size();
+  K = soft.collective;
+  C = soft.options.individual;
+  k_membrane = soft.options.membrane;
+  // The tissue's resistance to sliding along the skin, per unit c_i: the support springs hold a
+  // vertex only along their direction, the membrane only where it is stretched.
+  k_shear = soft.options.shear * K * C;
   std::vector<int> index(n, -1);
-  std::vector<uint32_t> vertex;
   for (size_t v = 0; v < n; ++v)
     if (soft.region_of[v] >= 0) {
       index[v] = static_cast<int>(vertex.size());
       vertex.push_back(static_cast<uint32_t>(v));
     }
-  const size_t m = vertex.size();
+  m = vertex.size();
+  for (const uint32_t v : vertex) {
+    const Vec3 d = soft.rest[v].cast<double>() - soft.frame[v].cast<double>();
+    rest_length.push_back(d.norm());
+    normal.push_back(d / std::max(rest_length.back(), 1e-12));
+    frame.push_back(soft.frame[v].cast<double>());
+    rest.push_back(soft.rest[v].cast<double>());
+    weight.push_back(soft.weight[v]);
+    region.push_back(soft.region_of[v]);
+  }
+  for (size_t k = 0; k < soft.edges.size(); ++k) {
+    const auto [a, b] = soft.edges[k];
+    edges.push_back({a, b, index[a], index[b], (soft.rest[a].cast<double>() - soft.rest[b].cast<double>()).norm()});
+  }
+  x.resize(n);
+  trial.resize(n);
+  for (size_t v = 0; v < n; ++v) x[v] = trial[v] = soft.rest[v].cast<double>();
+  if (m == 0) return;
+
+  // The pattern: each soft vertex's diagonal block and a block each way per membrane spring
+  // between two soft vertices; analysed once.
+  const auto rows = static_cast<Eigen::Index>(3 * m);
+  std::vector<Eigen::Triplet<double>> pattern;
+  const auto add_block = [&](int i, int j) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) pattern.emplace_back(3 * i + r, 3 * j + c, 0.0);
+  };
+  for (size_t i = 0; i < m; ++i) add_block(static_cast<int>(i), static_cast<int>(i));
+  for (const Edge& e : edges)
+    if (e.ia >= 0 && e.ib >= 0) {
+      add_block(e.ia, e.ib);
+      add_block(e.ib, e.ia);
+    }
+  H.resize(rows, rows);
+  H.setFromTriplets(pattern.begin(), pattern.end());
+  H.makeCompressed();
+  const auto slot_of = [&](int i, int j) {
+    std::array<int, 3> at{};
+    for (int c = 0; c < 3; ++c) {
+      const int col = 3 * j + c;
+      const int* begin = H.innerIndexPtr() + H.outerIndexPtr()[col];
+      const int* end = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
+      at[static_cast<size_t>(c)] = static_cast<int>(std::lower_bound(begin, end, 3 * i) - H.innerIndexPtr());
+    }
+    slots.push_back(at);
+    return static_cast<int>(slots.size() - 1);
+  };
+  for (size_t i = 0; i < m; ++i) diagonal.push_back(slot_of(static_cast<int>(i), static_cast<int>(i)));
+  for (Edge& e : edges)
+    if (e.ia >= 0 && e.ib >= 0) {
+      e.ab = slot_of(e.ia, e.ib);
+      e.ba = slot_of(e.ib, e.ia);
+    }
+  cholesky.analyzePattern(H);
+
+  A = Eigen::MatrixXd::Zero(rows, static_cast<Eigen::Index>(regions));
+  for (size_t i = 0; i < m; ++i)
+    A.block<3, 1>(static_cast<Eigen::Index>(3 * i), region[i]) = weight[i] * normal[i];
+  gradient.resize(rows);
+  step.resize(rows);
+  compressed_sum.assign(m, 0.0);
+}
+
+double SoftBodySolver::Impl::energy_of(const std::vector<Vec3>& p, std::span<const Vec3f> forces,
+                                       std::vector<double>& tot) const {
+  double e = 0;
+  tot.assign(regions, 0.0);
+  for (size_t i = 0; i < m; ++i) {
+    const uint32_t v = vertex[i];
+    const Vec3& u = normal[i];
+    const double dl = (p[v] - frame[i]).dot(u) - rest_length[i];
+    tot[static_cast<size_t>(region[i])] += weight[i] * dl;
+    e += 0.5 * K * C * weight[i] * dl * dl;
+    const Vec3 moved = p[v] - rest[i];
+    e += 0.5 * k_shear * weight[i] * (moved - moved.dot(u) * u).squaredNorm();
+    if (v < forces.size()) e -= forces[v].cast<double>().dot(moved);
+  }
+  for (const double t : tot) e += 0.5 * K * t * t;
+  for (const Edge& edge : edges) {
+    const double d = (p[edge.a] - p[edge.b]).norm() - edge.rest;
+    e += 0.5 * k_membrane * d * d;
+  }
+  return e;
+}
+
+bool SoftBodySolver::Impl::factorise() {
+  double* values = H.valuePtr();
+  std::fill(values, values + H.nonZeros(), 0.0);
+  const auto add = [&](int slot, const Mat3& h) {
+    const std::array<int, 3>& at = slots[static_cast<size_t>(slot)];
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) values[at[static_cast<size_t>(c)] + r] += h(r, c);
+  };
+  for (size_t i = 0; i < m; ++i) {
+    const Vec3& u = normal[i];
+    const Mat3 tangent = Mat3::Identity() - u * u.transpose();
+    add(diagonal[i], K * C * weight[i] * u * u.transpose() + k_shear * weight[i] * tangent);
+  }
+  // The membrane's compressed springs have negative curvature across them. Left out, the Hessian
+  // is stiffer than the body wherever a press compresses the skin, and Newton's steps fall short by
+  // a constant share; kept whole, it is indefinite where they outweigh the tissue's resistance to
+  // sliding (the skin buckles), and the factorisation fails. Each spring keeps as much of it as its
+  // ends' sliding resistance carries: an edge's term -n (I - u u^T) on x_a - x_b is at least -2 n
+  // (I - u u^T) on each end, so ends whose compressed terms sum to at most half their sliding
+  // stiffness leave the matrix positive definite.
+  std::fill(compressed_sum.begin(), compressed_sum.end(), 0.0);
+  for (const Edge& e : edges) {
+    const double l = std::max((x[e.a] - x[e.b]).norm(), 1e-12);
+    if (l >= e.rest) continue;
+    const double n = k_membrane * (e.rest / l - 1.0);
+    if (e.ia >= 0) compressed_sum[static_cast<size_t>(e.ia)] += n;
+    if (e.ib >= 0) compressed_sum[static_cast<size_t>(e.ib)] += n;
+  }
+  const auto share = [&](int i) {
+    if (i < 0) return 1.0;
+    const double sum = compressed_sum[static_cast<size_t>(i)];
+    const double carried = 0.5 * k_shear * weight[static_cast<size_t>(i)];
+    return sum > carried ? carried / sum : 1.0;
+  };
+  for (const Edge& e : edges) {
+    const Vec3 d = x[e.a] - x[e.b];
+    const double l = std::max(d.norm(), 1e-12);
+    const Mat3 h = spring_hessian(k_membrane, l, e.rest, d / l, std::min(share(e.ia), share(e.ib)));
+    if (e.ia >= 0) add(diagonal[static_cast<size_t>(e.ia)], h);
+    if (e.ib >= 0) add(diagonal[static_cast<size_t>(e.ib)], h);
+    if (e.ab >= 0) {
+      add(e.ab, -h);
+      add(e.ba, -h);
+    }
+  }
+  cholesky.factorize(H);
+  if (cholesky.info() != Eigen::Success) return false;
+  // (H + K A A^T)^-1 by Woodbury's identity: H^-1 - H^-1 A (1/K + A^T H^-1 A)^-1 A^T H^-1.
+  HA = cholesky.solve(A);
+  Eigen::MatrixXd inner = A.transpose() * HA;
+  inner.diagonal().array() += 1.0 / K;
+  small.compute(inner);
+  return true;
+}
+
+SoftSolve SoftBodySolver::Impl::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start) {
+  SoftSolve out;
+  for (size_t i = 0; i < m; ++i) {
+    const uint32_t v = vertex[i];
+    x[v] = start.size() == n ? start[v].cast<double>() : rest[i];
+  }
   const auto finish = [&] {
     out.positions.resize(n);
     for (size_t v = 0; v < n; ++v) out.positions[v] = soft.region_of[v] >= 0 ? Vec3f(x[v].cast<float>()) : soft.rest[v];
@@ -172,148 +368,53 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     return out;
   };
   if (m == 0) return finish();
-  const double K = soft.collective, C = soft.options.individual;
-  const double k_membrane = soft.options.membrane;
-  const size_t regions = soft.regions.size();
-  const auto force = [&](uint32_t v) -> Vec3 { return v < forces.size() ? Vec3(forces[v].cast<double>()) : Vec3(Vec3::Zero()); };
-  // Each support spring's direction (the rest normal) and rest length. Its length is measured
-  // along that direction: a spring perpendicular to the surface, as the paper has it, whose
-  // energy stays convex however deep the press (measured point to point, a vertex pushed past its
-  // frame point would find the spring's rest length again on the other side).
-  std::vector<double> rest_length(n, 0.0);
-  std::vector<Vec3> normal(n, Vec3::Zero());
-  for (uint32_t v : vertex) {
-    const Vec3 d = soft.rest[v].cast<double>() - soft.frame[v].cast<double>();
-    rest_length[v] = d.norm();
-    normal[v] = d / std::max(rest_length[v], 1e-12);
-  }
-  // The tissue's resistance to sliding along the skin, per unit c_i: the support springs hold a
-  // vertex only along their direction, the membrane only where it is stretched.
-  const double k_shear = soft.options.shear * K * C;
-  std::vector<double> edge_rest(soft.edges.size());
-  for (size_t k = 0; k < soft.edges.size(); ++k)
-    edge_rest[k] = (soft.rest[soft.edges[k][0]].cast<double>() - soft.rest[soft.edges[k][1]].cast<double>()).norm();
 
-  // Per region: dl_tot = sum c_i (l_i - l_i^0).
-  const auto energy_of = [&](const std::vector<Vec3>& p, std::vector<double>* dl_tot) {
-    double e = 0;
-    std::vector<double> tot(regions, 0.0);
-    for (uint32_t v : vertex) {
-      const double dl = (p[v] - soft.frame[v].cast<double>()).dot(normal[v]) - rest_length[v];
-      tot[static_cast<size_t>(soft.region_of[v])] += soft.weight[v] * dl;
-      e += 0.5 * K * C * soft.weight[v] * dl * dl;
-      const Vec3 moved = p[v] - soft.rest[v].cast<double>();
-      e += 0.5 * k_shear * soft.weight[v] * (moved - moved.dot(normal[v]) * normal[v]).squaredNorm();
-      e -= force(v).dot(moved);
-    }
-    for (double t : tot) e += 0.5 * K * t * t;
-    for (size_t k = 0; k < soft.edges.size(); ++k) {
-      const auto [a, b] = soft.edges[k];
-      const double d = (p[a] - p[b]).norm() - edge_rest[k];
-      e += 0.5 * k_membrane * d * d;
-    }
-    if (dl_tot) *dl_tot = std::move(tot);
-    return e;
-  };
-
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
-  bool analysed = false, factored = false;
   double last_residual = std::numeric_limits<double>::infinity();
-  std::vector<double> dl_tot;
-  double energy = energy_of(x, &dl_tot);
-  std::vector<Eigen::Triplet<double>> triplets;
+  double energy = energy_of(x, forces, dl_tot);
   for (int iteration = 0; iteration < 80; ++iteration) {
-    Eigen::VectorXd gradient = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m));
-    std::vector<Eigen::VectorXd> collective(regions, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(3 * m)));
-    triplets.clear();
-    const auto add_block = [&](int i, int j, const Mat3& h) {
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * i + r, 3 * j + c, h(r, c));
-    };
-    for (size_t s = 0; s < m; ++s) {
-      const uint32_t v = vertex[s];
-      const auto r = static_cast<size_t>(soft.region_of[v]);
-      const Vec3& u = normal[v];
-      const double c = soft.weight[v];
-      const double dl = (x[v] - soft.frame[v].cast<double>()).dot(u) - rest_length[v];
-      const auto at = static_cast<Eigen::Index>(3 * s);
-      // Eq. 6 (its negative: the energy's gradient) and the applied force.
-      gradient.segment<3>(at) += c * K * (dl_tot[r] + C * dl) * u - force(v);
-      collective[r].segment<3>(at) = c * u;
-      const Vec3 moved = x[v] - soft.rest[v].cast<double>();
-      const Mat3 tangent = Mat3::Identity() - normal[v] * normal[v].transpose();
-      gradient.segment<3>(at) += k_shear * c * (tangent * moved);
-      add_block(static_cast<int>(s), static_cast<int>(s), K * C * c * u * u.transpose() + k_shear * c * tangent);
-    }
-    for (size_t k = 0; k < soft.edges.size(); ++k) {
-      const auto [a, b] = soft.edges[k];
-      const Vec3 d = x[a] - x[b];
-      const double l = std::max(d.norm(), 1e-12);
-      const Vec3 u = d / l;
-      const Vec3 f = k_membrane * (l - edge_rest[k]) * u;  // the gradient with respect to a
-      const Mat3 h = spring_hessian(k_membrane, l, edge_rest[k], u);
-      const int ia = index[a], ib = index[b];
-      if (ia >= 0) {
-        gradient.segment<3>(3 * ia) += f;
-        add_block(ia, ia, h);
-      }
-      if (ib >= 0) {
-        gradient.segment<3>(3 * ib) -= f;
-        add_block(ib, ib, h);
-      }
-      if (ia >= 0 && ib >= 0) {
-        add_block(ia, ib, -h);
-        add_block(ib, ia, -h);
-      }
-    }
+    // The gradient: eq. 6 (its negative), the sliding and the applied force, then the membrane.
     double largest = 0;
-    for (size_t s = 0; s < m; ++s) largest = std::max(largest, gradient.segment<3>(static_cast<Eigen::Index>(3 * s)).norm());
+    for (size_t i = 0; i < m; ++i) {
+      const uint32_t v = vertex[i];
+      const Vec3& u = normal[i];
+      const double c = weight[i];
+      const double dl = (x[v] - frame[i]).dot(u) - rest_length[i];
+      const Vec3 moved = x[v] - rest[i];
+      Vec3 g = c * K * (dl_tot[static_cast<size_t>(region[i])] + C * dl) * u + k_shear * c * (moved - moved.dot(u) * u);
+      if (v < forces.size()) g -= forces[v].cast<double>();
+      gradient.segment<3>(static_cast<Eigen::Index>(3 * i)) = g;
+    }
+    for (const Edge& e : edges) {
+      const Vec3 d = x[e.a] - x[e.b];
+      const double l = std::max(d.norm(), 1e-12);
+      const Vec3 f = k_membrane * (l - e.rest) / l * d;  // the gradient with respect to a
+      if (e.ia >= 0) gradient.segment<3>(3 * e.ia) += f;
+      if (e.ib >= 0) gradient.segment<3>(3 * e.ib) -= f;
+    }
+    for (size_t i = 0; i < m; ++i) largest = std::max(largest, gradient.segment<3>(static_cast<Eigen::Index>(3 * i)).norm());
     out.residual_n = largest;
     if (largest < kConverged) break;
 
-    // The factorisation is most of a Newton iteration's cost: it is kept while full steps go on
-    // cutting the residual by 30 % or more (the Hessian changes little near the rest; with the
-    // compressed springs' negative curvature left out, fresh ones converge linearly too, about
-    // halving it), and made anew otherwise.
+    // The factorisation is most of a Newton iteration's cost: it is kept, from one iteration and
+    // one solve to the next, while full steps go on cutting the residual by 30 % or more (the
+    // Hessian changes little near the rest; where the compressed springs' negative curvature is
+    // cut short, fresh ones converge linearly too), and made anew otherwise.
     const bool refactor = !factored || largest > 0.7 * last_residual;
     last_residual = largest;
     if (refactor) {
-      Eigen::SparseMatrix<double> H(static_cast<Eigen::Index>(3 * m), static_cast<Eigen::Index>(3 * m));
-      H.setFromTriplets(triplets.begin(), triplets.end());
-      if (!analysed) {
-        solver.analyzePattern(H);
-        analysed = true;
-      }
-      solver.factorize(H);
-      if (solver.info() != Eigen::Success) break;
-      factored = true;
+      factored = factorise();
+      if (!factored) break;
       ++out.factorisations;
     }
-    // (H + K A A^T)^-1 g by Woodbury's identity, A holding one column per region (a few: the
-    // products are taken column by column).
-    const Eigen::VectorXd hg = solver.solve(gradient);
-    std::vector<Eigen::VectorXd> ha(regions);
-    for (size_t r = 0; r < regions; ++r) ha[r] = solver.solve(collective[r]);
-    Eigen::MatrixXd small(static_cast<Eigen::Index>(regions), static_cast<Eigen::Index>(regions));
-    Eigen::VectorXd rhs(static_cast<Eigen::Index>(regions));
-    for (size_t i = 0; i < regions; ++i) {
-      const auto a = static_cast<Eigen::Index>(i);
-      for (size_t j = 0; j < regions; ++j) small(a, static_cast<Eigen::Index>(j)) = collective[i].dot(ha[j]);
-      small(a, a) += 1.0 / K;
-      rhs(a) = collective[i].dot(hg);
-    }
-    const Eigen::VectorXd y = small.ldlt().solve(rhs);
-    Eigen::VectorXd step = -hg;
-    for (size_t r = 0; r < regions; ++r) step += y(static_cast<Eigen::Index>(r)) * ha[r];
+    step = -cholesky.solve(gradient);
+    step += HA * small.solve(A.transpose() * (-step));
 
     // Backtracking on the energy.
-    std::vector<Vec3> trial = x;
     double alpha = 1.0, trial_energy = energy;
-    std::vector<double> trial_tot;
     bool lower = false;
     for (int tries = 0; tries < 30; ++tries) {
-      for (size_t s = 0; s < m; ++s) trial[vertex[s]] = x[vertex[s]] + alpha * step.segment<3>(static_cast<Eigen::Index>(3 * s));
-      trial_energy = energy_of(trial, &trial_tot);
+      for (size_t i = 0; i < m; ++i) trial[vertex[i]] = x[vertex[i]] + alpha * step.segment<3>(static_cast<Eigen::Index>(3 * i));
+      trial_energy = energy_of(trial, forces, trial_tot);
       lower = trial_energy <= energy;
       if (lower) break;
       alpha *= 0.5;
@@ -325,11 +426,21 @@ SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, s
     }
     if (!lower) break;
     if (alpha < 0.75) factored = false;  // a shortened step: the Hessian has moved on
-    x.swap(trial);
+    for (size_t i = 0; i < m; ++i) x[vertex[i]] = trial[vertex[i]];
     dl_tot.swap(trial_tot);
     energy = trial_energy;
   }
   return finish();
+}
+
+SoftBodySolver::SoftBodySolver(const SoftBody& soft) : impl_(std::make_unique<Impl>(soft)) {}
+SoftBodySolver::~SoftBodySolver() = default;
+SoftSolve SoftBodySolver::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start) {
+  return impl_->solve(forces, start);
+}
+
+SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, std::span<const Vec3f> start) {
+  return SoftBodySolver(soft).solve(forces, start);
 }
 
 }  // namespace drape

@@ -183,10 +183,11 @@ DressResult dress(const Body& body, const std::vector<GarmentRequest>& requests,
     // settle again on the body as it gave way, until the body stops moving.
     t0 = clock();
     const SoftBody soft = make_soft_body(body, o.soft);
+    SoftBodySolver soft_solver(soft);
     SoftBodyResult sb{body, {}, 0, 0.0f, 0.0};
     for (int round = 0; round < o.soft_body_rounds; ++round) {
       const FitAnalysis fit = analyse_dress_fit(sb.body, result, garments);
-      const SoftSolve solved = solve_soft_body(soft, fit.pressure.force, sb.body.mesh.positions);
+      const SoftSolve solved = soft_solver.solve(fit.pressure.force, sb.body.mesh.positions);
       sb.last_move_m = 0;
       for (size_t v = 0; v < solved.positions.size(); ++v)
         sb.last_move_m = std::max(sb.last_move_m, (solved.positions[v] - sb.body.mesh.positions[v]).norm());

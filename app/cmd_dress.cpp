@@ -26,6 +26,8 @@ struct DressArgs {
   std::vector<std::string> garments;
   std::vector<std::string> sizes;
   std::string fabric;
+  float thickness = 0;
+  float friction = -1;
   std::string collision = "image";
   std::string solver = std::string(to_string(DressOptions{}.solver));
   std::string mesher = "grid";
@@ -58,6 +60,12 @@ void run_dress(const DressArgs& a) {
     throw InputError("--coarse-edge", "the coarse edge length must be 0 (off) or in [0.002, 0.2] m");
   o.coarse_edge = a.coarse_edge;
   if (!a.fabric.empty()) o.fabric = fabric_or_throw(a.fabric).name;
+  if (a.thickness != 0 && !(a.thickness >= 0.0005f && a.thickness <= 0.02f))
+    throw InputError("--thickness", "the distance the cloth keeps from the body must be in [0.0005, 0.02] m");
+  o.thickness = a.thickness;
+  if (a.friction != -1 && !(a.friction >= 0 && a.friction <= 2))
+    throw InputError("--friction", "the coefficient of friction must be in [0, 2]");
+  o.friction = a.friction;
   o.max_iterations = a.max_iterations;
   if (!(a.mass_scaling >= 0 && a.mass_scaling <= 1))
     throw InputError("--mass-scaling", "must be in [0, 1] (a fraction of the median particle's time step; 0: off)");
@@ -182,7 +190,15 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--size", args->sizes,
                   "size to make (one for all garments, or one per --garment); default: the size whose size chart "
                   "entry is nearest to the body's measurements (docs/garment-format.md), report.json says why");
-  cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own");
+  std::string presets;
+  for (const Fabric& f : fabric_presets()) presets += (presets.empty() ? "" : ", ") + f.name;
+  cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own: " + presets);
+  cmd->add_option("--thickness", args->thickness,
+                  "distance in metres the cloth keeps from the body and the garments beneath (its contact "
+                  "thickness; default: the fabric's, 0.004 for the presets)");
+  cmd->add_option("--friction", args->friction,
+                  "Coulomb coefficient of friction of the cloth on the body and the garments beneath "
+                  "(default: the fabric's, e.g. 0.3 for cotton; 0: frictionless)");
   cmd->add_option("--solver", args->solver,
                   "implicit (Newton on the incremental potential: quasi-static steps to equilibrium, the strain "
                   "limit, contact and friction inside the solve) or explicit (the paper's explicit Euler with "

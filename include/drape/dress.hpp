@@ -46,6 +46,11 @@ struct DressOptions {
   CollisionMethod collision = CollisionMethod::image;
   MeshOptions mesh{Mesher::grid, kPaperEdgeLength};
   std::string fabric;  // empty: each garment's own
+  // The fabric's contact with the body and with the garments beneath, overriding the fabric's own:
+  // the distance its particles keep from them (m; 0: Fabric::collision_thickness) and its Coulomb
+  // coefficient of friction on them (negative: Fabric::friction).
+  float thickness = 0.0f;
+  float friction = -1.0f;
   // Sewing: seam springs pull the pairs together with gravity off and frictionless contact; a pair
   // closer than `seam_closed_m` is joined (held together from then on); sewing ends when every pair
   // is joined, or after `max_sewing_seconds` of simulated time, or when it is stuck: over a window

@@ -15,7 +15,9 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   DressedGarment g;
   g.name = garment.name;
   g.size = garment.size;
-  const Fabric fabric = fabric_or_throw(o.fabric.empty() ? garment.fabric : o.fabric);
+  Fabric fabric = fabric_or_throw(o.fabric.empty() ? garment.fabric : o.fabric);
+  if (o.thickness > 0) fabric.collision_thickness = o.thickness;
+  if (o.friction >= 0) fabric.friction = o.friction;
   g.fabric = fabric.name;
   const GarmentMesh mesh = mesh_garment(garment, o.mesh);
   dressing::PlacedPanels placed = dressing::place_panels(body, garment, mesh, body_collider, fabric.collision_thickness);

@@ -68,6 +68,8 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"size", g.size},
                         {"size_reason", g.size_reason},
                         {"fabric", g.fabric},
+                        {"contact_thickness_m", g.model.fabric.collision_thickness},
+                        {"friction", g.model.fabric.friction},
                         {"vertices", g.model.particle_count()},
                         {"springs", g.model.spring_count()},
                         {"seam_pairs", g.seam_pairs.size()},

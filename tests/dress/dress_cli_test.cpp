@@ -41,6 +41,9 @@ TEST(DressCli, DefaultRunWritesTheThreeFiles) {
     EXPECT_TRUE(report["simulation"].contains(k)) << k;
   EXPECT_EQ(report["gates"]["passed"].get<bool>(), r.exit_code == 0);
   EXPECT_EQ(report["garments"][0]["name"], "shirt");
+  // The fabric's own contact with the body: cotton's friction and the 4 mm contact thickness.
+  EXPECT_NEAR(report["garments"][0]["friction"].get<double>(), 0.3, 1e-6);
+  EXPECT_NEAR(report["garments"][0]["contact_thickness_m"].get<double>(), 0.004, 1e-6);
   // The implicit solver (the default): Newton iterations and factorisations, and equilibrium.
   EXPECT_EQ(report["settings"]["solver"], "implicit");
   EXPECT_GT(report["garments"][0]["newton_iterations"].get<int>(), 0);
@@ -111,12 +114,20 @@ TEST(DressCli, UnknownSizeAndBodyFileAreRefused) {
   r = test::run_drape("dress --pull-closed 0.02 --out " + (dir / "f").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--pull-closed"), std::string::npos) << r.err;
+  r = test::run_drape("dress --friction 3 --out " + (dir / "g").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--friction"), std::string::npos) << r.err;
+  r = test::run_drape("dress --thickness 0.05 --out " + (dir / "h").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--thickness"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "a"));
   EXPECT_FALSE(std::filesystem::exists(dir / "b"));
   EXPECT_FALSE(std::filesystem::exists(dir / "c"));
   EXPECT_FALSE(std::filesystem::exists(dir / "d"));
   EXPECT_FALSE(std::filesystem::exists(dir / "e"));
   EXPECT_FALSE(std::filesystem::exists(dir / "f"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "g"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "h"));
 }
 
 TEST(DressCli, CappedRunFailsItsGatesWithExit3) {

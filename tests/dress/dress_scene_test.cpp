@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <mutex>
@@ -483,6 +484,47 @@ TEST(DressScene, LastStitchesArePulledClosedWhenSewingEnds) {
   EXPECT_LE(pulled.quality.max_strain, p.model.fabric.strain_threshold + 0.01f);
   EXPECT_TRUE(pulled.passed()) << test::failed_gates(pulled);
   EXPECT_GT(open.quality.max_seam_gap_m, DressOptions{}.pull_closed_m);
+}
+
+// The fabric's contact with the body, set for the dressing (DressOptions::friction, thickness;
+// `drape dress --friction --thickness`): the skirt on the default female body slides lower
+// without friction than with a grippy 0.8 (measured: 0.615 against 0.634 m for its centre), and
+// with an 8 mm contact thickness its cloth rests about twice as far off the skin as with the
+// fabric's 4 mm.
+TEST(DressScene, FrictionAndThicknessOverrideTheFabricsOwn) {
+  if (sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt on the default body";
+  const Body& body = cached_body(Sex::Female);
+  const GarmentSpec skirt = load_garment("skirt");
+  const auto dressed = [&](float friction, float thickness) {
+    DressOptions o;
+    o.friction = friction;
+    o.thickness = thickness;
+    return dress(body, {{skirt, "M"}}, o);
+  };
+  const DressResult slippery = dressed(0.0f, 0.0f), grippy = dressed(0.8f, 0.0f), thick = dressed(-1.0f, 0.008f);
+  for (const DressResult* r : {&slippery, &grippy, &thick}) EXPECT_TRUE(r->passed()) << failed_gates(*r);
+  const DressedGarment &s = slippery.garments.at(0), &g = grippy.garments.at(0), &t = thick.garments.at(0);
+  EXPECT_EQ(s.model.fabric.friction, 0.0f);
+  EXPECT_EQ(g.model.fabric.friction, 0.8f);
+  EXPECT_EQ(t.model.fabric.friction, fabric_or_throw(skirt.fabric).friction);
+  EXPECT_EQ(t.model.fabric.collision_thickness, 0.008f);
+  EXPECT_LT(s.final_centre_y, g.final_centre_y - 0.005f);
+  // The cloth's distance from the skin where it rests on the body (particles within 2 cm of it).
+  const auto collider = make_body_collider(body.mesh, CollisionMethod::bvh);
+  const auto resting = [&](const DressedGarment& garment) {
+    std::vector<ContactSample> near(garment.state.x.size());
+    collider->query(garment.state.x, 0.02f, near);
+    std::vector<float> d;
+    for (const ContactSample& c : near)
+      if (c.distance < 0.02f) d.push_back(c.distance);
+    std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 10), d.end());
+    return d.at(d.size() / 10);  // the closest tenth
+  };
+  const float at_4mm = resting(s), at_8mm = resting(t);
+  EXPECT_GT(at_8mm, at_4mm + 0.003f);
+  EXPECT_GT(at_8mm, 0.006f);
+  std::fprintf(stderr, "centre %.3f m without friction, %.3f m at 0.8; the closest tenth of the cloth %.1f mm off the skin at 4 mm, %.1f mm at 8 mm\n",
+               static_cast<double>(s.final_centre_y), static_cast<double>(g.final_centre_y), 1e3 * at_4mm, 1e3 * at_8mm);
 }
 
 // Layers: a skirt, then a shirt over it (outermost last); the shirt must not sink into the skirt.

@@ -176,6 +176,8 @@ void run_dress(const DressArgs& a) {
 
 // Settings only the explicit step uses: listed under their own heading in --help.
 constexpr const char* kExplicitGroup = "Explicit solver (--solver explicit)";
+// How the run goes rather than what is dressed: under their own heading in --help.
+constexpr const char* kRunGroup = "Running and inspecting";
 
 void add_dress_command(CLI::App& app) {
   auto args = std::make_shared<DressArgs>();
@@ -217,10 +219,12 @@ void add_dress_command(CLI::App& app) {
                   "coarse-to-fine: a garment meshed more than 1.25x finer than this is first sewn and draped at "
                   "this edge length, and the --edge garment starts from it (e.g. 0.026: the shirt and skirt at "
                   "16x the paper's vertices ~2x faster; see docs/dressing.md); 0: off")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->check(CLI::Range(0, 1024));
+      ->capture_default_str()
+      ->group(kRunGroup);
+  cmd->add_option("--threads", args->threads, "OpenMP threads (0: all cores)")->check(CLI::Range(0, 1024))->group(kRunGroup);
   cmd->add_option("--max-iterations", args->max_iterations,
-                  "stop each garment after this many iterations (0: no cap); a capped run fails the settled gate");
+                  "stop each garment after this many iterations (0: no cap); a capped run fails the settled gate")
+      ->group(kRunGroup);
   cmd->add_option("--mass-scaling", args->mass_scaling,
                   "particles whose stability bound is below this fraction of the median particle's get more inertia "
                   "(weight unchanged), for a longer time step; the state of rest is the same (0: off)")
@@ -246,7 +250,8 @@ void add_dress_command(CLI::App& app) {
       ->capture_default_str()
       ->group(kExplicitGroup);
   cmd->add_flag("--placement-only", args->placement_only,
-                "write the garments where placement put them, before sewing (fails the settled gate)");
+                "write the garments where placement put them, before sewing (fails the settled gate)")
+      ->group(kRunGroup);
   cmd->add_flag("--soft-body", args->soft_body,
                 "let the body give way: its soft regions (belly, buttocks, thighs, bust, upper arms) are pressed in by the "
                 "cloth and bulge elsewhere, keeping their volume (support springs, docs/soft-body.md); report.json soft_body");

@@ -324,9 +324,9 @@ bool SoftBodySolver::Impl::factorise() {
   for (const Edge& e : edges) {
     const double l = std::max((x[e.a] - x[e.b]).norm(), 1e-12);
     if (l >= e.rest) continue;
-    const double n = k_membrane * (e.rest / l - 1.0);
-    if (e.ia >= 0) compressed_sum[static_cast<size_t>(e.ia)] += n;
-    if (e.ib >= 0) compressed_sum[static_cast<size_t>(e.ib)] += n;
+    const double negative = k_membrane * (e.rest / l - 1.0);
+    if (e.ia >= 0) compressed_sum[static_cast<size_t>(e.ia)] += negative;
+    if (e.ib >= 0) compressed_sum[static_cast<size_t>(e.ib)] += negative;
   }
   const auto share = [&](int i) {
     if (i < 0) return 1.0;

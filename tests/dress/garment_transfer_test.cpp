@@ -76,19 +76,21 @@ TEST(GarmentTransfer, StartsTheSameGarmentOnAnotherBodyAndPassesTheGates) {
   EXPECT_LT(5 * warm_newton, 4 * cold_newton);
 }
 
-// The skirt M dressed on the default body (waist 0.74 m) moved onto one with a 0.78 m waist: its
-// band stays where it sat, 7.4 % stretched and 2-3 mm into the skin, where a skirt placed anew
-// slides to where the body's girth matches it. That start fails the gates, so the skirt is dressed
-// again from its placement, and passes.
+// The jeans M dressed on the default body (waist 0.74 m) moved onto one with a 0.78 m waist: the
+// denim's band, stiff and tight, does not come to rest within the gates where the transfer puts it,
+// where jeans placed anew slide to where the body's girth matches them. That start fails the gates,
+// so the jeans are dressed again from their placement, and pass. (The skirt, the case first used
+// here, now finds a rest within the gates from the transferred start, on bodies up to a 0.90 m
+// waist.)
 TEST(GarmentTransfer, AStartThatFailsTheGatesIsDressedAgainFromThePlacement) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: only the default shirt";
   const Body& from = cached_body(Sex::Female);
-  const DressResult first = dress(from, {{load_garment("skirt"), "M"}}, DressOptions{});
+  const DressResult first = dress(from, {{load_garment("jeans"), "M"}}, DressOptions{});
   ASSERT_TRUE(first.passed()) << failed_gates(first);
   const Body to = make_human_body(Sex::Female, {{"waist", 0.78f}, {"hips", 1.02f}});
   DressOptions o;
   o.transfers.push_back(std::make_shared<GarmentTransfer>(make_garment_transfer(from, first.garments.at(0))));
-  const DressResult r = dress(to, {{load_garment("skirt"), "M"}}, o);
+  const DressResult r = dress(to, {{load_garment("jeans"), "M"}}, o);
   ASSERT_EQ(r.garments.size(), 1u);
   EXPECT_FALSE(r.garments[0].transferred);
   EXPECT_TRUE(r.garments[0].transfer_failed);

@@ -33,7 +33,7 @@ TEST(WebTransfer, NextShopperStartsFromTheLastDrapeOfTheGarment) {
     const auto b = c.Post("/api/bodies", body_request.dump(), "application/json");
     EXPECT_TRUE(b && b->status == 201);
     const std::string body = json_of(b)["id"];
-    const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "skirt"}, {"size", "M"}}.dump(),
+    const auto r = c.Post("/api/tryons", json{{"body", body}, {"garment", "shirt"}, {"size", "M"}}.dump(),
                           "application/json");
     EXPECT_TRUE(r && r->status == 202);
     const std::string id = json_of(r)["id"];

@@ -158,7 +158,7 @@ struct SoftBodySolver::Impl {
 
   // The energy at `p` (every body vertex), with each region's dl_tot = sum c_i (l_i - l_i^0).
   double energy_of(const std::vector<Vec3>& p, std::span<const Vec3f> forces, std::vector<double>& tot) const;
-  // The Hessian's values at x_ (its pattern fixed), factorised, and the Woodbury terms with it.
+  // The Hessian's values at x (its pattern fixed), factorised, and the Woodbury terms with it.
   bool factorise();
 
   struct Edge {

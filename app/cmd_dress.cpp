@@ -192,9 +192,7 @@ void add_dress_command(CLI::App& app) {
   cmd->add_option("--size", args->sizes,
                   "size to make (one for all garments, or one per --garment); default: the size whose size chart "
                   "entry is nearest to the body's measurements (docs/garment-format.md), report.json says why");
-  std::string presets;
-  for (const Fabric& f : fabric_presets()) presets += (presets.empty() ? "" : ", ") + f.name;
-  cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own: " + presets);
+  cmd->add_option("--fabric", args->fabric, "fabric preset overriding the garments' own: " + fabric_preset_names());
   cmd->add_option("--thickness", args->thickness,
                   "distance in metres the cloth keeps from the body and the garments beneath (its contact "
                   "thickness; default: the fabric's, 0.004 for the presets)");

@@ -36,6 +36,8 @@ struct Fabric {
 
 // The built-in presets (cotton, denim, silk, jersey, wool, polyester, ...), in a fixed order.
 std::span<const Fabric> fabric_presets();
+// Their names, comma-separated, in that order (for messages and help).
+std::string fabric_preset_names();
 
 // The preset called `name` (case-sensitive), or nullptr.
 const Fabric* find_fabric(std::string_view name);

@@ -53,6 +53,12 @@ const std::array<Fabric, 7>& presets() {
 
 std::span<const Fabric> fabric_presets() { return presets(); }
 
+std::string fabric_preset_names() {
+  std::string names;
+  for (const Fabric& f : presets()) names += (names.empty() ? "" : ", ") + f.name;
+  return names;
+}
+
 const Fabric* find_fabric(std::string_view name) {
   for (const Fabric& f : presets())
     if (f.name == name) return &f;
@@ -61,9 +67,7 @@ const Fabric* find_fabric(std::string_view name) {
 
 const Fabric& fabric_or_throw(std::string_view name) {
   if (const Fabric* f = find_fabric(name)) return *f;
-  std::string known;
-  for (const Fabric& f : presets()) known += (known.empty() ? "" : ", ") + f.name;
-  throw InputError("--fabric", "unknown fabric '" + std::string(name) + "' (known: " + known + ")");
+  throw InputError("--fabric", "unknown fabric '" + std::string(name) + "' (known: " + fabric_preset_names() + ")");
 }
 
 void validate_fabric(const Fabric& f, const std::string& source) {

@@ -65,6 +65,21 @@ struct ImplicitSettings {
   // The springs' exact Hessian blocks (a factorisation that fails, where the cloth buckles, falls
   // back to the projected ones for the rest of the step), else each made positive semi-definite.
   bool exact_hessian = true;
+  // Vertex block descent (Chen et al. 2024) inside a dynamic step's Newton iterations: before each
+  // iteration (and after the last, unless it converged), this many Gauss-Seidel sweeps over colours
+  // of particles that share no spring or stencil, each particle moved by the Newton step of its own
+  // 3x3 block of E with every other particle held, shortened by a backtracking line search on its
+  // own terms. Newton's direct solve carries what is global (stretch across the cloth, a garment
+  // carried by the body); the sweeps what is local and stiff and not in the last factorisation's
+  // matrix (a spring crossing the strain barrier's start, a contact met or left), which Newton's
+  // iterations otherwise go back and forth over. 0: none. Quasi-static steps do not sweep (no gain
+  // in dressing: docs/cloth.md).
+  int block_sweeps = 0;
+  // 0: a fresh factorisation whenever the conjugate gradients miss (above). k > 0: a fresh one at
+  // the step's first Newton iteration and every k iterations after; in between, the conjugate
+  // gradients' direction on it as far as they got (the block sweeps correct what they miss).
+  // `drape animate` asks for 4 (two factorisations in its steps of 8 iterations).
+  int factorisation_interval = 0;
   // Self-contact: every free particle is kept the fabric's contact thickness from the triangles of
   // the same cloth that are not its own neighbourhood on the pattern (a skirt's folds, a collar
   // turned down, the two layers of a sleeve), with the body contact's penalty, acting on the
@@ -88,9 +103,11 @@ struct ImplicitStepStats {
 struct ImplicitProfile {
   double contacts = 0, assemble = 0, factorize = 0, solve = 0, line_search = 0;
   double self_contacts = 0;  // finding the self-contact pairs
+  double sweeps = 0;         // block descent (ImplicitSettings::block_sweeps)
   uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
   uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration and one to start them
-  double total_seconds() const { return contacts + self_contacts + assemble + factorize + solve + line_search; }
+  uint64_t block_sweeps = 0;
+  double total_seconds() const { return contacts + self_contacts + sweeps + assemble + factorize + solve + line_search; }
 };
 
 // The solver for one model: its sparse pattern and ordering are analysed once, at construction;

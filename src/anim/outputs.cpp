@@ -210,7 +210,8 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                        {"assemble", r.profile.assemble},
                        {"factorize", r.profile.factorize},
                        {"solve", r.profile.solve},
-                       {"line_search", r.profile.line_search}}},
+                       {"line_search", r.profile.line_search},
+                       {"block_sweeps", r.profile.sweeps}}},
                      {"measure_seconds", r.measure_seconds},
                      {"dress_seconds", r.dress_seconds},
                      {"retarget_seconds", r.retarget_seconds}};

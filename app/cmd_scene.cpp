@@ -296,7 +296,8 @@ void run_scene(const SceneArgs& a) {
     report["simulation"]["factorizations"] = p.factorizations;
     report["simulation"]["implicit_stage_seconds"] = {{"contacts", p.contacts}, {"assemble", p.assemble},
                                                       {"factorize", p.factorize}, {"solve", p.solve},
-                                                      {"line_search", p.line_search}};
+                                                      {"line_search", p.line_search}, {"block_sweeps", p.sweeps}};
+    report["simulation"]["block_sweeps"] = p.block_sweeps;
   }
   report["scene"] = {{"obstacle", a.obstacle},
                      {"n", a.n},

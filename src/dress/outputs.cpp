@@ -119,7 +119,8 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                                                     {"assemble", g.implicit_profile.assemble},
                                                     {"factorize", g.implicit_profile.factorize},
                                                     {"solve", g.implicit_profile.solve},
-                                                    {"line_search", g.implicit_profile.line_search}}}});
+                                                    {"line_search", g.implicit_profile.line_search},
+                                                    {"block_sweeps", g.implicit_profile.sweeps}}}});
   }
   extra["garments"] = garments;
   extra["body"] = {{"vertices", body.mesh.vertex_count()},

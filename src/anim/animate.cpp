@@ -344,21 +344,13 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // Loose Newton directions (ImplicitSettings::direction_tolerance): cheaper iterations whose
     // errors the next ones correct; the walk at 1.4x the frames per wall second with the same gates,
     // the run within its gates where exact directions let 1.8 % of the shirt into the body
-    // (docs/animation.md).
-    is.direction_tolerance = 0.5;
-    // Block sweeps between the Newton iterations (ImplicitSettings::block_sweeps) and a fresh
-    // factorisation every 4 of them: a walk's Newton iterations went back and forth over springs
-    // crossing the strain barrier's start and contacts met or left, which the sweeps settle
-    // locally, and the directions from the factorisations, 3 conjugate-gradient iterations each on
-    // the last, carry the rest. Against 16 Newton iterations a step, each factorising whenever 5
-    // conjugate-gradient iterations missed: 2.5-4x fewer factorisations, every gate passed
-    // (docs/animation.md). One factorisation a step was faster still (the walk 3.9 frames per wall
-    // second against 3.2), but the shirt over the skirt at 4 cm cells then ended a frame with
-    // 1.3 % of its vertices inside the body (the gate 1 %).
-    is.block_sweeps = 4;
+    // (docs/animation.md). Block sweeps between the Newton iterations settle locally what the
+    // last factorisation's matrix did not know (springs crossing the strain barrier's start,
+    // contacts met or left), over which a walk's iterations went back and forth: at most 8
+    // iterations a step, where there were 16 each factorising whenever 5 conjugate-gradient
+    // iterations missed.
+    sweep_dynamic_steps(is);
     is.max_newton_iterations = 8;
-    is.factorisation_interval = 4;
-    is.direction_iterations = 3;
     if (o.friction >= 0) is.friction = o.friction;
     // Static friction's range: 1 mm, where dressing holds the cloth within 0.1 mm. The body drags
     // the cloth by millimetres in a step, and Newton's iterates crossed a 0.1 mm range between

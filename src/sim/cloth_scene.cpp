@@ -49,13 +49,9 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
     s.implicit_settings.strain_threshold =
         o.strain_limit == StrainLimit::None ? std::numeric_limits<float>::max() : s.settings.strain_threshold;
     if (o.time_step > 0) s.implicit_settings.time_step = o.time_step;
-    // Dynamic steps as `drape animate` takes them: block sweeps between the Newton iterations, a
-    // factorisation every 4 (docs/cloth.md). The sphere scene at n = 64: 8.2 s for its 2 s against
-    // 14.3 s, the same strain and nothing inside (docs/benchmarks.md).
-    s.implicit_settings.block_sweeps = 4;
-    s.implicit_settings.factorisation_interval = 4;
-    s.implicit_settings.direction_tolerance = 0.5;
-    s.implicit_settings.direction_iterations = 3;
+    // Dynamic steps as `drape animate` takes them. The sphere scene at n = 64: 8.2 s for its 2 s
+    // against 14.3 s, the same strain and nothing inside (docs/benchmarks.md).
+    sweep_dynamic_steps(s.implicit_settings);
   }
   return s;
 }

@@ -232,15 +232,17 @@ inline void add_spring(SpringTerm& t, const Vec3d& d, double l, double rest, dou
 
 // Zero-length seam: k/2 l^2 up to the length where it pulls with `cap`, then a constant pull of
 // `cap` (its Hessian: the zero-length spring that pulls with `cap` at this length).
+inline bool seam_capped(double l, double k, double cap) { return cap > 0 && k * l > cap; }
+inline double seam_energy(double l, double k, double cap) {
+  return seam_capped(l, k, cap) ? cap * (l - 0.5 * (cap / k)) : 0.5 * k * l * l;
+}
 inline void add_seam(SpringTerm& t, const Vec3d& d, double l, double k, double cap) {
-  if (cap > 0 && k * l > cap) {
-    const double reach = cap / k;
-    t.energy += cap * (l - 0.5 * reach);
+  t.energy += seam_energy(l, k, cap);
+  if (seam_capped(l, k, cap)) {
     t.gradient_b += (cap / l) * d;
     t.hessian.diagonal().array() += cap / l;
     return;
   }
-  t.energy += 0.5 * k * l * l;
   t.gradient_b += k * d;
   t.hessian.diagonal().array() += k;
 }
@@ -276,6 +278,13 @@ struct SymmetricBlock {
 }  // namespace
 
 std::string_view to_string(Solver solver) { return solver == Solver::Explicit ? "explicit" : "implicit"; }
+
+void sweep_dynamic_steps(ImplicitSettings& s) {
+  s.block_sweeps = 4;
+  s.factorisation_interval = 4;
+  s.direction_tolerance = 0.5;
+  s.direction_iterations = 3;
+}
 
 ImplicitSettings default_implicit_settings(const ClothModel& model) {
   ImplicitSettings s;
@@ -403,6 +412,10 @@ struct ImplicitSolver::Impl {
   double friction_scale(size_t i, double slip) const {
     return slip < friction_slip ? friction_force[i] / friction_slip : friction_force[i] / slip;
   }
+  // Its energy: friction_scale's force integrated along the slip.
+  double friction_energy(size_t i, double slip) const {
+    return friction_force[i] * (slip < friction_slip ? 0.5 * slip * slip / friction_slip : slip - 0.5 * friction_slip);
+  }
   // Particle i's tangential slip at `p` from where friction holds it.
   Vec3d tangential_slip(size_t i, const Vec3d& p) const {
     Vec3d u = p - x0[i] - surface_velocity[i] + held_slip[i];
@@ -455,10 +468,10 @@ struct ImplicitSolver::Impl {
   void assemble(const ImplicitSettings& s, double h);
   float residual(const ImplicitSettings& s);
 
-  // Block descent (ImplicitSettings::Method::BlockDescent): the particles in colours that share no
-  // spring or stencil (CSR, index order within each), the stencils each particle is in (3 q + its
-  // slot j), and Chebyshev's two earlier iterates.
-  std::vector<uint32_t> colour_begin, colour_particle;
+  // Block sweeps (ImplicitSettings::block_sweeps): the particles in colours that share no spring or
+  // stencil (CSR, index order within each), each particle's colour, and the stencils each particle
+  // is in (3 q + its slot j).
+  std::vector<uint32_t> colour_begin, colour_particle, particle_colour;
   std::vector<uint32_t> stencil_begin, stencil_slot;
   void colour_particles();
   // The self-contact pairs each particle is in (CSR: 4 pair + its role, 0 the particle, 1-3 the
@@ -466,7 +479,6 @@ struct ImplicitSolver::Impl {
   // move one after another, after the rest of their colour (deferred).
   std::vector<uint32_t> self_begin, self_entry;
   std::vector<uint8_t> deferred;
-  std::vector<uint32_t> particle_colour;
   void index_self_pairs();
   // Cloths of fewer particles sweep on one thread: a sweep has a barrier per colour, and where the
   // two cores are shared (two processes, or tests side by side) a barrier can wait a scheduler time
@@ -746,8 +758,7 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       if (pen > 0) e += contact_energy(contact_k[i], pen);
       if (in_crease[i]) e += contact_energy(contact_k[i], crease_depth(i, at[i]));
       if (friction_force[i] > 0) {
-        const double u = tangential_slip(i, at[i]).norm();
-        e += friction_force[i] * (u < friction_slip ? 0.5 * u * u / friction_slip : u - 0.5 * friction_slip);
+        e += friction_energy(i, tangential_slip(i, at[i]).norm());
       }
     }
     block_sum[b] = e;
@@ -1050,7 +1061,9 @@ void ImplicitSolver::Impl::colour_particles() {
   }
   // Greedy colouring in index order: the smallest colour no neighbour has yet.
   constexpr uint32_t kNone = UINT32_MAX;
-  std::vector<uint32_t> colour(n, kNone), taken;
+  std::vector<uint32_t>& colour = particle_colour;
+  colour.assign(n, kNone);
+  std::vector<uint32_t> taken;
   uint32_t colours = 0;
   for (size_t i = 0; i < n; ++i) {
     taken.assign(colours + 1, 0);
@@ -1064,7 +1077,6 @@ void ImplicitSolver::Impl::colour_particles() {
   colour_begin.assign(colours + 1, 0);
   for (size_t i = 0; i < n; ++i) ++colour_begin[colour[i] + 1];
   for (uint32_t c = 0; c < colours; ++c) colour_begin[c + 1] += colour_begin[c];
-  particle_colour = colour;
   colour_particle.resize(n);
   std::vector<uint32_t> next(colour_begin.begin(), colour_begin.end() - 1);
   for (size_t i = 0; i < n; ++i) colour_particle[next[colour[i]]++] = static_cast<uint32_t>(i);
@@ -1105,11 +1117,9 @@ double ImplicitSolver::Impl::block_terms(size_t i, const Vec3d& p, const Implici
     const double side = a_end ? -1.0 : 1.0;
     if (k >= seams.begin && k < seams.end) {
       // add_seam's terms.
-      const double reach = s.seam_force > 0 ? s.seam_force / s.seam_stiffness : 0.0;
-      const bool capped = reach > 0 && l > reach;
-      e += capped ? s.seam_force * (l - 0.5 * reach) : 0.5 * s.seam_stiffness * l * l;
+      e += seam_energy(l, s.seam_stiffness, s.seam_force);
       if (!grad) continue;
-      const double c = capped ? s.seam_force / l : s.seam_stiffness;
+      const double c = seam_capped(l, s.seam_stiffness, s.seam_force) ? s.seam_force / l : s.seam_stiffness;
       gr += side * c * d;
       h.add_diagonal(c);
       continue;
@@ -1187,7 +1197,7 @@ double ImplicitSolver::Impl::block_terms(size_t i, const Vec3d& p, const Implici
     if (friction_force[i] > 0) {
       const Vec3d u = tangential_slip(i, p);
       const double slip = u.norm();
-      e += friction_force[i] * (slip < friction_slip ? 0.5 * slip * slip / friction_slip : slip - 0.5 * friction_slip);
+      e += friction_energy(i, slip);
       if (grad) {
         // assemble()'s friction block: scale (I - n n^T), less the slip's direction where it slides.
         const double scale = friction_scale(i, slip);
@@ -1402,6 +1412,11 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   // to the projected blocks for the rest of the step.
   w.exact = s.exact_hessian;
   const int sweeps = s.quasi_static ? 0 : s.block_sweeps;
+  const auto sweep = [&] {
+    w.block_descent(colliders, s, h, sweeps);
+    if (profile) profile->block_sweeps += static_cast<uint64_t>(sweeps);
+    timer.mark(profile ? profile->sweeps : scratch_time);
+  };
   for (int it = 0; it < s.max_newton_iterations; ++it) {
     if (it > 0) w.detect_contacts(colliders, s, h, false);
     if (s.quasi_static)
@@ -1427,11 +1442,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
       w.add_self_blocks();
       timer.mark(profile ? profile->self_contacts : scratch_time);
     }
-    if (sweeps > 0) {
-      w.block_descent(colliders, s, h, sweeps);
-      if (profile) profile->block_sweeps += static_cast<uint64_t>(sweeps);
-      timer.mark(profile ? profile->sweeps : scratch_time);
-    }
+    if (sweeps > 0) sweep();
     w.assemble(s, hd);
     timer.mark(profile ? profile->assemble : scratch_time);
     if (s.quasi_static && w.force_ratio <= s.force_tolerance && relags < kMaxRelags &&
@@ -1536,9 +1547,7 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   // sweeps take the iterate on from there.
   if (sweeps > 0 && !st.converged && state.status == StepStatus::Ok) {
     w.detect_contacts(colliders, s, h, false);
-    w.block_descent(colliders, s, h, sweeps);
-    if (profile) profile->block_sweeps += static_cast<uint64_t>(sweeps);
-    timer.mark(profile ? profile->sweeps : scratch_time);
+    sweep();
   }
   // The state: positions, velocities from the step (quasi-static: at rest), and the slip friction
   // holds (where it slides, the slip at which it does: the anchor follows the particle).

@@ -61,7 +61,10 @@ TriangleBvh::TriangleBvh(const BodySurface& surface, bool refit) : surface_(surf
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("Embree: cannot create a device");
   scene_ = rtcNewScene(device_);
-  rtcSetSceneBuildQuality(scene_, refit ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
+  // Embree refits a geometry's BVH (RTC_BUILD_QUALITY_REFIT) only in a scene of low build quality,
+  // its two-level structure; in any other scene every commit rebuilt the body's BVH (8 ms of the 12
+  // ms a moving 47.5k-triangle body took per update, against 1 ms refitted; queries as fast).
+  rtcSetSceneBuildQuality(scene_, refit ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_HIGH);
   if (refit) rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_DYNAMIC);
   geometry_ = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
   if (refit) rtcSetGeometryBuildQuality(geometry_, RTC_BUILD_QUALITY_REFIT);

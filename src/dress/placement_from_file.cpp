@@ -145,6 +145,26 @@ PanelSide side_of(const Vec3d& outward) {
 
 Vec3f to_f(const Vec3d& v) { return v.cast<float>(); }
 
+// Whether the straight line between a seam pair's two vertices, where a layout puts them, passes
+// through the body: sewing pulls the partners together along it, and the body stops them on the
+// way instead of the seam closing around it.
+bool seam_crosses_body(const std::vector<std::vector<Vec3f>>& positions, const std::vector<SeamVertexPair>& pairs,
+                       const Collider& body_collider) {
+  constexpr float kStep = 0.01f;        // m between the points tested along a pair's line
+  constexpr float kRadius = 0.25f;      // m: the query reaches the surface from deep inside the torso
+  constexpr float kInside = -0.005f;    // m: a point this far inside the body is in it
+  std::vector<Vec3f> points;
+  for (const SeamVertexPair& s : pairs) {
+    const Vec3f a = positions[s.panel_a][s.vertex_a];
+    const Vec3f b = positions[s.panel_b][s.vertex_b];
+    const int n = static_cast<int>(std::ceil((b - a).norm() / kStep));
+    for (int i = 1; i < n; ++i) points.push_back(a + (b - a) * (static_cast<float>(i) / static_cast<float>(n)));
+  }
+  std::vector<ContactSample> contact(points.size());
+  body_collider.query(points, kRadius, contact);
+  return std::any_of(contact.begin(), contact.end(), [](const ContactSample& c) { return c.distance < kInside; });
+}
+
 }  // namespace
 
 PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, const GarmentMesh& mesh,
@@ -240,12 +260,15 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       h.anchor.y() += (l.waist.y() - 0.5 * (l.left_shoulder.y() + l.right_shoulder.y())) / rise[p];
     }
 
-  // A GarmentCode garment without sleeves whose flat sheets already lie clear of the body starts
-  // from the file's own layout, as GarmentCode's simulator starts it: its seams close around the
-  // body without crossing a limb (measured on mean_all: the hoody's seams all close from there,
-  // rolled its side seams stay 11 cm open). With sleeves the flat side and underarm seams would
-  // have to close across the A-posed arms, and the 2021 templates were laid out around another
-  // body in another pose: those are rolled.
+  // A GarmentCode garment without sleeves whose flat sheets already lie clear of the body, and
+  // whose seams close without passing through it, starts from the file's own layout, as
+  // GarmentCode's simulator starts it (measured on mean_all: the hoody's seams all close from
+  // there, rolled its side seams stay 11 cm open). With sleeves the flat side and underarm seams
+  // would have to close across the A-posed arms, and the 2021 templates were laid out around
+  // another body in another pose: those are rolled. So is a layout with a seam whose partners face
+  // each other through the body: the pencil dress's straps lie 3-6 cm below mean_all's shoulders,
+  // front and back, and pulled together they closed under the arms, not over the shoulders (the
+  // dress then slid 0.25 m down the body; rolled, it passes every gate).
   if (!pelvis_origin && !any_arm) {
     PlacedPanels out;
     out.positions.resize(garment.panels.size());
@@ -260,7 +283,7 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       for (const ContactSample& c : contact) clear = clear && c.distance >= kFlatClearance;
       out.info[p] = {garment.panels[p].name, "transform: flat, as in the file", kFlatClearance, 0};
     }
-    if (clear) return out;
+    if (clear && !seam_crosses_body(out.positions, mesh.seam_pairs, body_collider)) return out;
   }
 
   PlacedPanels out = place_panels(body, rolled, rolled_mesh, body_collider, collision_thickness);

@@ -12,6 +12,11 @@ namespace drape {
 
 DressedGarment prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
                                const DressOptions& o) {
+  return dressing::prepare_garment(body, garment, body_collider, o, dressing::PlacementUse::sewing);
+}
+
+DressedGarment dressing::prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
+                                         const DressOptions& o, PlacementUse use) {
   DressedGarment g;
   g.name = garment.name;
   g.size = garment.size;
@@ -20,7 +25,7 @@ DressedGarment prepare_garment(const Body& body, const Garment& garment, const C
   if (o.friction >= 0) fabric.friction = o.friction;
   g.fabric = fabric.name;
   const GarmentMesh mesh = mesh_garment(garment, o.mesh);
-  dressing::PlacedPanels placed = dressing::place_panels(body, garment, mesh, body_collider, fabric.collision_thickness);
+  dressing::PlacedPanels placed = dressing::place_panels(body, garment, mesh, body_collider, fabric.collision_thickness, use);
   dressing::GarmentCloth cloth = dressing::garment_cloth_spec(garment, mesh, placed, fabric);
   dressing::gather_elastic_bands(body, garment, mesh, placed, cloth);
   g.model = compile(std::move(cloth.spec));

@@ -19,6 +19,7 @@
 
 #include "drape/collision.hpp"
 #include "drape/size_advice.hpp"
+#include "dress/stages.hpp"
 
 namespace drape {
 namespace {
@@ -309,7 +310,7 @@ std::vector<PatternSize> measure_pattern(const Body& body, const GarmentSpec& sp
   const auto collider = make_body_collider(body.mesh, options.collision, few_queries);
   for (const std::string& size : spec.sizes) {
     const Garment garment = garment_in_size(spec, size);
-    const DressedGarment placed = prepare_garment(body, garment, *collider, options);
+    const DressedGarment placed = dressing::prepare_garment(body, garment, *collider, options, dressing::PlacementUse::measuring);
     out.push_back({size, pattern_girths(body, placed, garment, spec)});
   }
   return out;

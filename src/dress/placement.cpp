@@ -616,11 +616,11 @@ void place_region(const Body& body, const Garment& garment, const GarmentMesh& m
 }  // namespace
 
 PlacedPanels place_panels(const Body& body, const Garment& garment, const GarmentMesh& mesh,
-                          const Collider& body_collider, float collision_thickness) {
+                          const Collider& body_collider, float collision_thickness, PlacementUse use) {
   // Imports with the file's own 3D placement (GarmentCode, 2021 templates): placement_from_file.cpp.
   if (!garment.panels.empty() &&
       std::all_of(garment.panels.begin(), garment.panels.end(), [](const Panel& p) { return p.transform.has_value(); }))
-    return place_panels_from_file(body, garment, mesh, body_collider, collision_thickness);
+    return place_panels_from_file(body, garment, mesh, body_collider, collision_thickness, use);
   PlacedPanels out;
   out.positions.resize(garment.panels.size());
   out.info.resize(garment.panels.size());

@@ -168,7 +168,7 @@ bool seam_crosses_body(const std::vector<std::vector<Vec3f>>& positions, const s
 }  // namespace
 
 PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, const GarmentMesh& mesh,
-                                    const Collider& body_collider, float collision_thickness) {
+                                    const Collider& body_collider, float collision_thickness, PlacementUse use) {
   const Landmarks& l = body.landmarks;
   bool pelvis_origin = false;
   for (const Panel& p : garment.panels) pelvis_origin = pelvis_origin || p.transform->pelvis_origin;
@@ -268,7 +268,9 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
   // another body in another pose: those are rolled. So is a layout with a seam whose partners face
   // each other through the body: the pencil dress's straps lie 3-6 cm below mean_all's shoulders,
   // front and back, and pulled together they closed under the arms, not over the shoulders (the
-  // dress then slid 0.25 m down the body; rolled, it passes every gate).
+  // dress then slid 0.25 m down the body; rolled, it passes every gate). Measuring the pattern
+  // keeps the file's layout wherever it lies clear of the body: rolled over the shoulders, a
+  // bodice's heights are no longer its lengths.
   if (!pelvis_origin && !any_arm) {
     PlacedPanels out;
     out.positions.resize(garment.panels.size());
@@ -283,7 +285,8 @@ PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, co
       for (const ContactSample& c : contact) clear = clear && c.distance >= kFlatClearance;
       out.info[p] = {garment.panels[p].name, "transform: flat, as in the file", kFlatClearance, 0};
     }
-    if (clear && !seam_crosses_body(out.positions, mesh.seam_pairs, body_collider)) return out;
+    if (clear && (use == PlacementUse::measuring || !seam_crosses_body(out.positions, mesh.seam_pairs, body_collider)))
+      return out;
   }
 
   PlacedPanels out = place_panels(body, rolled, rolled_mesh, body_collider, collision_thickness);

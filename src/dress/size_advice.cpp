@@ -15,6 +15,7 @@
 
 #include "drape/collision.hpp"
 #include "drape/size_advice.hpp"
+#include "dress/stages.hpp"
 
 namespace drape {
 namespace {
@@ -189,7 +190,8 @@ SizeAdvice advise_size(const Body& body, const GarmentSpec& spec, const DressOpt
     few_queries.candidate_grid = false;
     const auto placement_collider = make_body_collider(body.mesh, options.collision, few_queries);
     for (SizeTrial& t : advice.sizes) {
-      const DressedGarment placed = prepare_garment(body, t.garment, *placement_collider, options);
+      const DressedGarment placed =
+          dressing::prepare_garment(body, t.garment, *placement_collider, options, dressing::PlacementUse::measuring);
       t.pattern = pattern_measurements(body, fit_garment(placed, t.garment));
       t.pattern_girths = pattern_girths(body, placed, t.garment, spec);
     }

@@ -14,12 +14,20 @@ struct PlacedPanels {
   std::vector<std::vector<Vec3f>> positions;
   std::vector<PanelPlacement> info;
 };
+// What the panels are placed for: to be sewn (a layout whose seams close round the body), or to
+// measure the pattern's lines on (pattern_chart.cpp: the heights as drafted, a file's own layout
+// wherever it lies clear of the body).
+enum class PlacementUse { sewing, measuring };
 PlacedPanels place_panels(const Body& body, const Garment& garment, const GarmentMesh& mesh,
-                          const Collider& body_collider, float collision_thickness);
+                          const Collider& body_collider, float collision_thickness,
+                          PlacementUse use = PlacementUse::sewing);
 // Imported panels that carry the file's 3D placement (placement_from_file.cpp): hints and panel
 // orientation read from it, then rolled as above. place_panels calls it when every panel has one.
 PlacedPanels place_panels_from_file(const Body& body, const Garment& garment, const GarmentMesh& mesh,
-                                    const Collider& body_collider, float collision_thickness);
+                                    const Collider& body_collider, float collision_thickness, PlacementUse use);
+// prepare_garment (drape/dress.hpp) with the panels placed for `use`.
+DressedGarment prepare_garment(const Body& body, const Garment& garment, const Collider& body_collider,
+                               const DressOptions& options, PlacementUse use);
 
 // Stage 4 (garment_model.cpp): one cloth spec for all panels (grid topology springs where the
 // grid mesher made the panel, triangle-mesh springs otherwise) and zero-length seam springs.

@@ -179,6 +179,11 @@ struct ClothState {
   // The implicit solver's static friction, carried from step to step: each particle's tangential
   // slip from where friction holds it (m, at most the slip at which it slides; empty: none).
   std::vector<Vec3f> friction_slip;
+  // What rounding the implicit solver's positions to x left out: its double-precision positions are
+  // x + x_rounding, carried into the next step (empty: none). A stiff spring at the strain
+  // barrier turns the float rounding of its ends (~1e-8 m) into a force of several times a
+  // particle's weight, which a step converged to a hundredth of one would otherwise start from.
+  std::vector<Vec3f> x_rounding;
   // Measured at the end of the last step.
   float max_speed = 0;        // m/s
   double kinetic_energy = 0;  // J

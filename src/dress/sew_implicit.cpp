@@ -129,6 +129,7 @@ void sew_and_drape_implicit(DressedGarment& g, std::span<Collider* const> collid
     g.settled = status == StepStatus::Ok && moved <= o.settle_distance_m;
     if (!g.settled && status == StepStatus::Ok) {
       g.state.x = trial.x;
+      g.state.x_rounding = trial.x_rounding;
       g.residual = solver.residual(g.state.x, colliders, s);
     }
   }

@@ -73,6 +73,8 @@ constexpr double kReplane = 1e-3;  // m
 // thickness of it. From 60 degrees, the default trousers on the female body took 431 Newton
 // iterations instead of 254 (planes of one wall's curve kept as a crease's).
 constexpr double kCreaseCosine = 0.0;
+constexpr double kTurnedCosine = 0.9994;  // a plane found anew turned by more than 2 degrees
+constexpr double kMaxReplane = 8e-3;     // m
 constexpr double kCreaseReach = 2e-3;  // m
 // A block sweep moves a particle this little without checking that its energy fell.
 constexpr double kSweepSettled = 1e-6;  // m
@@ -356,6 +358,13 @@ struct ImplicitSolver::Impl {
   // Per step and iteration (allocated once).
   std::vector<Vec3d> x, x0, y, trial;     // positions now, at the step start, inertial target, trial
   std::vector<Vec3d> detected_at;         // positions where the contacts were found
+  // How far each particle in contact moves before its plane is found anew: kReplane, doubled (up
+  // to kMaxReplane) each time a plane found anew turned (kTurnedCosine). Found anew at every
+  // millimetre, a particle's plane could go round in a cycle with Newton's iterations, each plane
+  // sending it back to where the last was found, for ever: the skirt M at an 8 mm contact
+  // thickness (between two walls of the body) and the trousers L on the default female body
+  // repeated the same 4-5 iterations until their steps ran out.
+  std::vector<double> replane_reach;
   std::vector<Vec3f> xf;                  // float positions for the colliders
   std::vector<ContactSample> sample, sample_tmp;
   std::vector<Vec3d> plane_normal;        // per particle: contact plane d(x) = n.x + c
@@ -509,6 +518,7 @@ ImplicitSolver::Impl::Impl(const ClothModel& m, size_t colliders) : model(m), n(
   y.resize(n);
   trial.resize(n);
   detected_at.resize(n);
+  replane_reach.assign(n, kReplane);
   refresh.resize(n);
   xf.resize(n);
   sample.resize(n);
@@ -664,7 +674,7 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
   size_t count = 0;
   for (size_t i = 0; i < n; ++i) {
     if (!free[i]) continue;
-    const double reach = in_range[i] ? kReplane : static_cast<double>(s.max_move);
+    const double reach = in_range[i] ? replane_reach[i] : static_cast<double>(s.max_move);
     if (refresh_all || (x[i] - detected_at[i]).squaredNorm() > reach * reach) {
       refresh[count] = static_cast<uint32_t>(i);
       xf[count] = x[i].cast<float>();
@@ -707,6 +717,8 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
       } else if (in_crease[i] && crease_depth(i, x[i]) <= -kCreaseReach) {
         in_crease[i] = 0;
       }
+      if (refresh_all) replane_reach[i] = kReplane;
+      else if (was && normal.dot(plane_normal[i]) < kTurnedCosine) replane_reach[i] = std::min(kMaxReplane, 2.0 * replane_reach[i]);
       plane_normal[i] = normal;
       plane_offset[i] = static_cast<double>(c.distance) - plane_normal[i].dot(x[i]);
       surface_velocity[i] = c.velocity.cast<double>() * h;  // the surface's displacement over the step
@@ -1376,8 +1388,10 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   // Start: x0 = x_n; the inertial target y = x_n + h v_n (at rest: x_n); pinned particles follow y.
   // Newton starts at x_n, where the contacts are found: started at y, cloth falling onto a sphere
   // at 1/30 s began its steps up to 10 cm into it, and was pushed through.
+  const bool rounded = state.x_rounding.size() == w.n;
   for (size_t i = 0; i < w.n; ++i) {
     w.x0[i] = state.x[i].cast<double>();
+    if (rounded) w.x0[i] += state.x_rounding[i].cast<double>();
     w.y[i] = s.quasi_static ? w.x0[i] : Vec3d(w.x0[i] + h * state.v[i].cast<double>());
     w.x[i] = w.free[i] ? w.x0[i] : w.y[i];
   }
@@ -1576,6 +1590,11 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     kinetic += 0.5 * static_cast<double>(w.model.mass[i]) * static_cast<double>(v.squaredNorm());
   }
   if (!finite && state.status == StepStatus::Ok) state.status = StepStatus::NonFinite;
+  // What the rounding left out, from the positions as stored: in the loop above, GCC 12's
+  // vectoriser at -O3 -march=native folds the double -> float -> double round trip away and
+  // leaves it zero.
+  state.x_rounding.resize(w.n);
+  for (size_t i = 0; i < w.n; ++i) state.x_rounding[i] = (w.x[i] - state.x[i].cast<double>()).cast<float>();
   state.time += h;
   ++state.iterations;
   state.max_speed = std::sqrt(speed2);

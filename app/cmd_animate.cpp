@@ -35,7 +35,7 @@ struct AnimateArgs {
   std::string dress_solver = "implicit";
   bool soft_body = false;
   bool skin_layer = false;
-  int substeps = 3;
+  int substeps = 1;
   float friction = AnimateOptions{}.friction;
   int threads = 0;
   bool no_video = false;
@@ -193,7 +193,7 @@ void add_animate_command(CLI::App& app) {
                 "keep the body's parts out of each other where skinning drives them in (hands lowered onto the hips, an "
                 "arm against the torso): a skin on zero-length springs to the skinned body, pushed apart where two parts "
                 "meet, with room for the cloth between (docs/soft-body.md)");
-  cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame")->capture_default_str()->check(CLI::Range(1, 64));
+  cmd->add_option("--substeps", args->substeps, "implicit solver steps per frame, at least (more where the body moves more than 3 cm in a step)")->capture_default_str()->check(CLI::Range(1, 64));
   cmd->add_option("--friction", args->friction,
                   "friction between the cloth and the moving skin, which carries the cloth along with the body "
                   "(Coulomb coefficient; negative: the fabric's)")

@@ -348,9 +348,9 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     // last factorisation's matrix did not know (springs crossing the strain barrier's start,
     // contacts met or left), over which a walk's iterations went back and forth: at most 8
     // iterations a step, where there were 16 each factorising whenever 5 conjugate-gradient
-    // iterations missed.
+    // iterations missed; 6 since a step starts where the body carries the cloth.
     sweep_dynamic_steps(is);
-    is.max_newton_iterations = 8;
+    is.max_newton_iterations = 6;
     if (o.friction >= 0) is.friction = o.friction;
     // Static friction's range: 1 mm, where dressing holds the cloth within 0.1 mm. The body drags
     // the cloth by millimetres in a step, and Newton's iterates crossed a 0.1 mm range between
@@ -434,7 +434,7 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     }
     // Steps this frame: the body's travel near the garments over the frame, cut into steps of at
     // most max_body_step. Over all the body's vertices (its hands and feet swing farthest), the
-    // walk took 6.3 steps a frame at 1.5 cm a step where it now takes 4.9 at 1.2 cm (docs/animation.md).
+    // walk took 6.3 steps a frame at 1.5 cm a step where 4.9 near the garments (docs/animation.md).
     float travel = 0;
     const VertexGrid grid(skin[f - 1], kNearCloth);
     for (size_t g = 0; g < ng; ++g) travel = std::max(travel, travel_near(grid, skin[f - 1], skin[f], states[g], near, moved));

@@ -377,7 +377,8 @@ struct ImplicitSolver::Impl {
   std::vector<double> crease_offset;
   std::vector<uint8_t> in_crease;
   std::vector<double> friction_force;     // per particle: lagged normal force x mu (N)
-  std::vector<Vec3d> surface_velocity;
+  std::vector<Vec3d> surface_velocity;  // per particle: its surface's displacement over the step
+  double planes_h = 0;                  // the step surface_velocity was found for (s)
   std::vector<Vec3d> held_slip;           // per particle: the slip friction held at the step's start
   std::vector<SpringTerm> spring_term;
   Eigen::VectorXd gradient, direction;
@@ -724,6 +725,7 @@ void ImplicitSolver::Impl::detect_contacts(std::span<Collider* const> colliders,
       surface_velocity[i] = c.velocity.cast<double>() * h;  // the surface's displacement over the step
     }
   });
+  planes_h = h;
 }
 
 void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s, bool at_step_start) {
@@ -735,7 +737,7 @@ void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s, bool at_step_
     // the depth there, the displacement along the normal taken off (a walking body's 1.5 cm a step
     // would otherwise give friction a thousand times the particle's weight, and hold the cloth to
     // where the body dragged it).
-    double d = depth(i, x[i]);
+    double d = depth(i, at_step_start ? x0[i] : x[i]);
     if (at_step_start) d -= plane_normal[i].dot(surface_velocity[i]);
     friction_force[i] = in_range[i] ? mu * contact_force(contact_k[i], d) : 0.0;
   }
@@ -1398,6 +1400,27 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   if (!w.analysed) {
     w.analyse_pattern();
     w.analysed = true;
+  }
+  // Colliders that move carry the cloth that lies on them: Newton's iterations start (the iterate
+  // only: inertia and friction still measure from x_n) with a particle within the contact layer's
+  // reach of its plane where its surface's motion over the last step would take it, and every other
+  // particle at its inertial target y. Started at x_n, a body moving towards the cloth is found up to
+  // its whole displacement over the step past the particle, where the nearest surface of a thin part
+  // (a hand, a forearm) can be its far side, and cloth swinging with the body is pulled back to
+  // where it was by the first iteration's inertia: the walk needed steps of at most 1.2 cm of the
+  // body's motion and 8 Newton iterations to stay within its gates; started this way, steps of 3 cm
+  // and 6 iterations keep it further within them (docs/animation.md). A particle whose target lies
+  // within its contact layer (falling onto the surface) starts at x_n.
+  if (s.moving_colliders && !s.quasi_static && w.planes_valid && w.planes_h > 0) {
+    const double scale = h / w.planes_h;
+    const double reach = static_cast<double>(w.model.fabric.collision_thickness);
+    for (size_t i = 0; i < w.n; ++i) {
+      if (!w.free[i]) continue;
+      if (w.in_range[i] && w.depth(i, w.x0[i]) > -reach)
+        w.x[i] = w.x0[i] + scale * w.surface_velocity[i];
+      else if (!w.in_range[i] || w.depth(i, w.y[i]) < 0)
+        w.x[i] = w.y[i];
+    }
   }
   ImplicitStepStats st;
   w.friction_slip = std::max(s.friction_slip, 1e-9);

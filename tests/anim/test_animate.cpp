@@ -210,7 +210,8 @@ TEST(AnimateCli, WritesItsOutputs) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/synthetic/synthetic_arms_raise_cmu_skeleton.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: dressing and rendering are Release tests";
   const auto dir = test::temp_dir("animate_cli");
-  const auto res = test::run_drape("animate --motion '" + path.string() + "' --frames 0:6 --blend 0.1 --out '" + dir.string() + "'");
+  // The shirt meshed at 4 cm cells (--edge): about half the vertices of the default 2.6 cm.
+  const auto res = test::run_drape("animate --motion '" + path.string() + "' --frames 0:6 --blend 0.1 --edge 0.04 --out '" + dir.string() + "'");
   // 0, or 3 when a frame failed a gate: the outputs are written either way.
   ASSERT_TRUE(res.exit_code == 0 || res.exit_code == 3) << res.err;
   for (const char* f : {"anim.glb", "frames.png", "report.json"}) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
@@ -231,6 +232,8 @@ TEST(AnimateCli, WritesItsOutputs) {
   // Friction carries the shirt along with the body: cotton's coefficient unless asked otherwise.
   ASSERT_EQ(j["garments"].size(), 1u);
   EXPECT_FLOAT_EQ(j["garments"][0]["friction"].get<float>(), fabric_or_throw("cotton").friction);
+  EXPECT_GT(j["garments"][0]["vertices"].get<int>(), 400);
+  EXPECT_LT(j["garments"][0]["vertices"].get<int>(), 900);
   // The animation reads back: skinned body, its animation, the shirt's frames as morph targets.
   const Scene s = read_scene(dir / "anim.glb");
   ASSERT_EQ(s.animations.size(), 1u);
@@ -252,6 +255,11 @@ TEST(AnimateCli, MalformedMotionAndUnknownSkeletonExit2WritingNothing) {
                         (dir / "out").string() + "'");
   EXPECT_EQ(res.exit_code, 2);
   EXPECT_NE(res.err.find("--soft-body"), std::string::npos) << res.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+
+  res = test::run_drape("animate --edge 0.5 --motion '" + bad.string() + "' --out '" + (dir / "out").string() + "'");
+  EXPECT_EQ(res.exit_code, 2);
+  EXPECT_NE(res.err.find("--edge"), std::string::npos) << res.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "out"));
 
   const auto robot = dir / "robot.bvh";

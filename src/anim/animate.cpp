@@ -336,21 +336,14 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     is.time_step = r.time_step;
     is.moving_colliders = true;
     is.quasi_static = false;
-    // A frame's steps end once no particle is off balance by more than its weight (dressing asks
-    // for 0.2 % of it): at most g h^2 = 1.2 mm off where nothing stiffer than inertia holds it, far
-    // less in the cloth. The walk's steps then take 9.8 Newton iterations instead of 10.8, with
-    // the same gates passed.
-    is.force_tolerance = 1.0;
-    // Loose Newton directions (ImplicitSettings::direction_tolerance): cheaper iterations whose
-    // errors the next ones correct; the walk at 1.4x the frames per wall second with the same gates,
-    // the run within its gates where exact directions let 1.8 % of the shirt into the body
-    // (docs/animation.md). Block sweeps between the Newton iterations settle locally what the
+    // Dynamic steps (sweep_dynamic_steps): loose Newton directions, cheaper iterations whose errors
+    // the next ones correct (the walk at 1.4x the frames per wall second with the same gates, the
+    // run within its gates where exact directions let 1.8 % of the shirt into the body,
+    // docs/animation.md); block sweeps between the Newton iterations, which settle locally what the
     // last factorisation's matrix did not know (springs crossing the strain barrier's start,
-    // contacts met or left), over which a walk's iterations went back and forth: at most 8
-    // iterations a step, where there were 16 each factorising whenever 5 conjugate-gradient
-    // iterations missed; 6 since a step starts where the body carries the cloth.
+    // contacts met or left), over which a walk's iterations went back and forth; at most 6
+    // iterations a step, ending once no particle is off balance by more than its weight.
     sweep_dynamic_steps(is);
-    is.max_newton_iterations = 6;
     if (o.friction >= 0) is.friction = o.friction;
     // Static friction's range: 1 mm, where dressing holds the cloth within 0.1 mm. The body drags
     // the cloth by millimetres in a step, and Newton's iterates crossed a 0.1 mm range between

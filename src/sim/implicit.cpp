@@ -282,6 +282,8 @@ struct SymmetricBlock {
 std::string_view to_string(Solver solver) { return solver == Solver::Explicit ? "explicit" : "implicit"; }
 
 void sweep_dynamic_steps(ImplicitSettings& s) {
+  s.force_tolerance = 1.0;
+  s.max_newton_iterations = 6;
   s.block_sweeps = 4;
   s.factorisation_interval = 4;
   s.direction_tolerance = 0.5;

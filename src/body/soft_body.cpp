@@ -21,7 +21,6 @@ float along(const Vec3f& p, const Vec3f& a, const Vec3f& b) {
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
-constexpr double kConverged = 1e-5;  // N: the largest force left on a soft vertex
 
 // A spring's Hessian from its length l, rest length L and unit direction u: k u u^T + k (1 - L / l)
 // (I - u u^T). Compressed (l < L) the second term is negative, and `compressed` is the share of it
@@ -154,7 +153,7 @@ std::vector<SoftRegionState> soft_region_states(const SoftBody& soft, std::span<
 
 struct SoftBodySolver::Impl {
   explicit Impl(const SoftBody& s);
-  SoftSolve solve(std::span<const Vec3f> forces, std::span<const Vec3f> start);
+  SoftSolve solve(std::span<const Vec3f> forces, std::span<const Vec3f> start, double tolerance);
 
   // The energy at `p` (every body vertex), with each region's dl_tot = sum c_i (l_i - l_i^0).
   double energy_of(const std::vector<Vec3>& p, std::span<const Vec3f> forces, std::vector<double>& tot) const;
@@ -355,7 +354,7 @@ bool SoftBodySolver::Impl::factorise() {
   return true;
 }
 
-SoftSolve SoftBodySolver::Impl::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start) {
+SoftSolve SoftBodySolver::Impl::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start, double tolerance) {
   SoftSolve out;
   for (size_t i = 0; i < m; ++i) {
     const uint32_t v = vertex[i];
@@ -393,7 +392,7 @@ SoftSolve SoftBodySolver::Impl::solve(std::span<const Vec3f> forces, std::span<c
     }
     for (size_t i = 0; i < m; ++i) largest = std::max(largest, gradient.segment<3>(static_cast<Eigen::Index>(3 * i)).norm());
     out.residual_n = largest;
-    if (largest < kConverged) break;
+    if (largest < tolerance) break;
 
     // The factorisation is most of a Newton iteration's cost: it is kept, from one iteration and
     // one solve to the next, while full steps go on cutting the residual by 30 % or more (the
@@ -435,8 +434,8 @@ SoftSolve SoftBodySolver::Impl::solve(std::span<const Vec3f> forces, std::span<c
 
 SoftBodySolver::SoftBodySolver(const SoftBody& soft) : impl_(std::make_unique<Impl>(soft)) {}
 SoftBodySolver::~SoftBodySolver() = default;
-SoftSolve SoftBodySolver::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start) {
-  return impl_->solve(forces, start);
+SoftSolve SoftBodySolver::solve(std::span<const Vec3f> forces, std::span<const Vec3f> start, double tolerance) {
+  return impl_->solve(forces, start, tolerance);
 }
 
 SoftSolve solve_soft_body(const SoftBody& soft, std::span<const Vec3f> forces, std::span<const Vec3f> start) {

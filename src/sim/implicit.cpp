@@ -495,8 +495,10 @@ struct ImplicitSolver::Impl {
   // Cloths of fewer particles sweep on one thread: a sweep has a barrier per colour, and where the
   // two cores are shared (two processes, or tests side by side) a barrier can wait a scheduler time
   // slice. Parallel from 512 particles, the walking shirt's frames per wall second were 1.16x on an
-  // idle machine, but the run's test took 6.5x as long beside another.
-  static constexpr size_t kParallelSweeps = 8192;
+  // idle machine, but the run's test (the shirt at 4 cm cells, 700 particles) took 6.5x as long
+  // beside another. From 2048: the walking dress of 4,198 particles sweeps in 3.1 s against 5.6 s
+  // on one thread (2.91 frames per wall second against 2.60, the same bits).
+  static constexpr size_t kParallelSweeps = 2048;
   // Particle i's move: the Newton step of its own block of E with every other particle held.
   Vec3d block_step(size_t i, const ImplicitSettings& s, double inv_h2) const;
   // The terms of E that involve particle i, with i at p and every other particle at x: their energy,

@@ -1393,7 +1393,8 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
   for (Collider* c : colliders) c->update(state.time + h);
   // Start: x0 = x_n; the inertial target y = x_n + h v_n (at rest: x_n); pinned particles follow y.
   // Newton starts at x_n, where the contacts are found: started at y, cloth falling onto a sphere
-  // at 1/30 s began its steps up to 10 cm into it, and was pushed through.
+  // at 1/30 s began its steps up to 10 cm into it, and was pushed through. (On colliders that move,
+  // the start is moved on below.)
   const bool rounded = state.x_rounding.size() == w.n;
   for (size_t i = 0; i < w.n; ++i) {
     w.x0[i] = state.x[i].cast<double>();

@@ -1,6 +1,8 @@
 // `drape scene sphere|table`: Vassilev & Spanlang fig. 7. Drops a square cloth over a sphere or a
 // table, runs until it settles and writes DIR/report.json (DESIGN.md's quality and simulation
 // keys), DIR/scene.glb and DIR/preview.png. Exit 3 when a gate failed (NaN, explosion, not settled).
+// `drape scene sew`: ../shared/peers' sewing scene, two panels sewn into a tube round a cylinder
+// (drape/cloth_scene.hpp), on the implicit solver; the same outputs with the seams' gaps.
 // `drape scene cusick`: the Cusick drape test of a fabric (drape/cusick.hpp), the same outputs with
 // the drape coefficient in report.json and the specimen's shadow in preview.png.
 #include <algorithm>
@@ -33,7 +35,7 @@ struct SceneArgs {
   int passes = 2;
   std::string fabric = "cotton";
   float time_step = 0;
-  std::string solver;  // empty: explicit for sphere and table, implicit for cusick
+  std::string solver;  // empty: explicit for sphere and table, implicit for sew and cusick
   double max_time = 12;
   double edge = 0.01;
   std::string out = "out";
@@ -51,8 +53,8 @@ struct Finished {
 Finished simulate(const ClothSceneOptions& o, double max_time, const std::string& label) {
   Finished f{make_cloth_scene(o), {}, {}, label};
   const float dt = f.scene.time_step();
-  std::fprintf(stderr, "scene %s: %u x %u cloth (%s), %s solver, %s, dt %.3g s\n", std::string(to_string(o.obstacle)).c_str(),
-               o.n, o.n, o.fabric.name.c_str(), std::string(to_string(o.solver)).c_str(), label.c_str(), dt);
+  std::fprintf(stderr, "scene %s: %zu particles (%s), %s solver, %s, dt %.3g s\n", std::string(to_string(o.obstacle)).c_str(),
+               f.scene.model.particle_count(), o.fabric.name.c_str(), std::string(to_string(o.solver)).c_str(), label.c_str(), dt);
   SettleCriteria settle;
   settle.max_time = max_time;
   f.run = run_until_settled(f.scene, settle, [](const ClothState& s) {
@@ -60,18 +62,23 @@ Finished simulate(const ClothSceneOptions& o, double max_time, const std::string
                  static_cast<unsigned long long>(s.iterations), s.max_speed);
   });
   f.quality = scene_quality(f.scene);
-  std::fprintf(stderr, "  %s after %llu iterations (%.2f s simulated, %.2f s wall): max strain %.4f, p99 %.4f, %zu inside\n",
+  std::fprintf(stderr, "  %s after %llu iterations (%.2f s simulated, %.2f s wall): max strain %.4f, p99 %.4f, %zu inside",
                f.run.status != StepStatus::Ok ? "FAILED" : f.run.settled ? "settled" : "NOT settled",
                static_cast<unsigned long long>(f.run.iterations), f.scene.state.time, f.run.wall_seconds,
                f.quality.strain.max, f.quality.strain.p99, f.quality.penetrating_vertices);
+  if (!f.scene.seam_pairs.empty()) std::fprintf(stderr, ", widest seam %.2f mm", 1e3 * f.quality.max_seam_gap);
+  std::fprintf(stderr, "\n");
   return f;
 }
 
-std::string limit_label(StrainLimit limit, float threshold) {
+std::string limit_label(StrainLimit limit, float threshold, Solver solver) {
   if (limit == StrainLimit::None) return "no strain limit";
   char buf[96];
-  std::snprintf(buf, sizeof buf, "%s modification at %.3g %%", limit == StrainLimit::Velocity ? "velocity" : "position",
-                100.0 * threshold);
+  if (solver == Solver::Implicit)
+    std::snprintf(buf, sizeof buf, "strain limit at %.3g %% (in the solve)", 100.0 * threshold);
+  else
+    std::snprintf(buf, sizeof buf, "%s modification at %.3g %%", limit == StrainLimit::Velocity ? "velocity" : "position",
+                  100.0 * threshold);
   return buf;
 }
 
@@ -230,9 +237,13 @@ void run_cusick_scene(const SceneArgs& a) {
 void run_scene(const SceneArgs& a) {
   if (a.obstacle == "cusick") return run_cusick_scene(a);
   ClothSceneOptions o;
-  if (a.obstacle != "sphere" && a.obstacle != "table")
-    throw InputError("scene", "unknown scene '" + a.obstacle + "' (sphere, table or cusick)");
-  o.obstacle = a.obstacle == "sphere" ? SceneObstacle::Sphere : SceneObstacle::Table;
+  static const std::map<std::string, SceneObstacle> obstacles = {
+      {"sphere", SceneObstacle::Sphere}, {"table", SceneObstacle::Table}, {"sew", SceneObstacle::Sew}};
+  const auto obstacle = obstacles.find(a.obstacle);
+  if (obstacle == obstacles.end())
+    throw InputError("scene", "unknown scene '" + a.obstacle + "' (sphere, table, sew or cusick)");
+  o.obstacle = obstacle->second;
+  const bool sew = o.obstacle == SceneObstacle::Sew;
   o.n = a.n;
   o.fabric = fabric_or_throw(a.fabric);
   static const std::map<std::string, StrainLimit> limits = {
@@ -244,17 +255,19 @@ void run_scene(const SceneArgs& a) {
   o.strain_passes = a.passes;
   if (!(a.time_step >= 0 && a.time_step < 0.1f)) throw InputError("--dt", "the time step must be in [0, 0.1) s");
   o.time_step = a.time_step;
-  o.solver = a.solver == "implicit" ? Solver::Implicit : Solver::Explicit;  // empty: explicit (fig. 7)
+  // Empty: explicit for fig. 7's scenes, implicit for sewing (its 1000 N/m seams on particles of a
+  // few grams hold the explicit step to steps of about 0.1 ms).
+  o.solver = a.solver == "implicit" || (sew && a.solver.empty()) ? Solver::Implicit : Solver::Explicit;
   if (!(a.max_time > 0 && a.max_time <= 600)) throw InputError("--max-time", "must be in (0, 600] s");
   const float threshold = a.threshold >= 0 ? a.threshold : o.fabric.strain_threshold;
 
-  Finished main_run = simulate(o, a.max_time, limit_label(o.strain_limit, threshold));
+  Finished main_run = simulate(o, a.max_time, limit_label(o.strain_limit, threshold, o.solver));
   // The paper's point in one picture: the same cloth without a limit, or with velocity modification.
   std::optional<Finished> other;
-  if (a.compare) {
+  if (a.compare && !sew) {
     ClothSceneOptions c = o;
     c.strain_limit = o.strain_limit == StrainLimit::None ? StrainLimit::Velocity : StrainLimit::None;
-    other = simulate(c, a.max_time, limit_label(c.strain_limit, threshold));
+    other = simulate(c, a.max_time, limit_label(c.strain_limit, threshold, c.solver));
   }
   const ClothScene& scene = main_run.scene;
   const SceneRun& run = main_run.run;
@@ -268,11 +281,12 @@ void run_scene(const SceneArgs& a) {
                        {"penetrating_vertices", q.penetrating_vertices},
                        {"penetration_fraction", q.penetration_fraction},
                        {"max_penetration_m", q.max_penetration},
-                       {"max_seam_gap_m", 0.0},
-                       {"mean_seam_gap_m", 0.0},
+                       {"max_seam_gap_m", q.max_seam_gap},
+                       {"mean_seam_gap_m", q.mean_seam_gap},
                        {"settled", run.settled},
                        {"residual", ImplicitSolver(scene.model, scene.colliders.size())
-                                        .residual(scene.state.x, scene.colliders, default_implicit_settings(scene.model))}};
+                                        .residual(scene.state.x, scene.colliders,
+                                                  scene.implicit ? scene.implicit_settings : default_implicit_settings(scene.model))}};
   const auto per_iteration = [&](double total) { return run.iterations ? total / static_cast<double>(run.iterations) : 0.0; };
   report["simulation"] = {{"iterations", run.iterations},
                           {"time_step_s", dt},
@@ -283,6 +297,7 @@ void run_scene(const SceneArgs& a) {
                           {"status", std::string(to_string(run.status))},
                           {"vertices", scene.model.particle_count()},
                           {"springs", scene.model.spring_count()},
+                          {"seam_pairs", scene.seam_pairs.size()},
                           {"strain_passes_per_iteration", per_iteration(static_cast<double>(run.profile.strain_passes))},
                           {"iterations_at_pass_limit", run.profile.steps_at_pass_limit},
                           {"contacts_per_iteration", per_iteration(static_cast<double>(run.profile.contacts))}};
@@ -350,12 +365,14 @@ void run_scene(const SceneArgs& a) {
 void add_scene_command(CLI::App& app) {
   auto args = std::make_shared<SceneArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "scene", "Drop a square cloth over a sphere or a table (paper fig. 7), or hang a fabric in the Cusick drape test, until it settles");
+      "scene", "Drop a square cloth over a sphere or a table (paper fig. 7), sew two panels round a cylinder, or hang a "
+               "fabric in the Cusick drape test, until it settles");
   cmd->add_option("obstacle", args->obstacle,
-                  "sphere or table (fig. 7), or cusick: a 30 cm disc of the fabric clamped on an 18 cm support; "
-                  "report.json gives its drape_coefficient")
-      ->check(CLI::IsMember({"sphere", "table", "cusick"}));
-  cmd->add_option("--n", args->n, "cloth vertices per side (sphere, table)")->capture_default_str()->check(CLI::Range(3u, 2048u));
+                  "sphere or table (fig. 7); sew: two 0.5 x 0.6 m panels sewn at their sides and shoulders into a tube "
+                  "round a 0.3 m cylinder (the sewing scene of ../shared/peers, Blender's); or cusick: a 30 cm disc of "
+                  "the fabric clamped on an 18 cm support, report.json gives its drape_coefficient")
+      ->check(CLI::IsMember({"sphere", "table", "sew", "cusick"}));
+  cmd->add_option("--n", args->n, "cloth vertices per side (sphere, table); sew: across each panel (64: 9856 vertices)")->capture_default_str()->check(CLI::Range(3u, 2048u));
   cmd->add_option("--strain-limit", args->strain_limit, "none, position (Provot) or velocity (paper sec. 3.3)")
       ->capture_default_str()->check(CLI::IsMember({"none", "position", "velocity"}));
   cmd->add_option("--threshold", args->threshold, "stretch threshold as a fraction (default: the fabric's)")
@@ -366,7 +383,7 @@ void add_scene_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--solver", args->solver,
                   "explicit (the paper's explicit Euler with velocity modification) or implicit (implicit Euler, "
-                  "Newton on the incremental potential); default: explicit for sphere and table, implicit for cusick")
+                  "Newton on the incremental potential); default: explicit for sphere and table, implicit for sew and cusick")
       ->check(CLI::IsMember({"explicit", "implicit"}));
   cmd->add_option("--dt", args->time_step, "time step in seconds (default: the stability bound, eq. 4)");
   cmd->add_option("--edge", args->edge, "cusick: the specimen's grid spacing in metres")->capture_default_str()

@@ -1,6 +1,8 @@
-// The fig. 7 scenes: a square cloth dropped over a sphere or a table (see drape/cloth_scene.hpp).
+// The fig. 7 scenes (a square cloth dropped over a sphere or a table) and the peers' sewing scene
+// (two panels sewn round a cylinder); see drape/cloth_scene.hpp.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include "drape/cloth_scene.hpp"
@@ -9,8 +11,78 @@
 namespace drape {
 
 std::string_view to_string(SceneObstacle obstacle) {
-  return obstacle == SceneObstacle::Sphere ? "sphere" : "table";
+  switch (obstacle) {
+    case SceneObstacle::Sphere: return "sphere";
+    case SceneObstacle::Table: return "table";
+    case SceneObstacle::Sew: return "sew";
+  }
+  return "?";
 }
+
+namespace {
+
+// The sewing scene's layout (../shared/peers/blender_drape.py, build_sew_scene, z up there).
+constexpr float kPanelWidth = 0.5f, kPanelHeight = 0.6f, kPanelBottom = 0.45f, kPanelOffset = 0.2f;
+constexpr float kShoulderFrom = 0.09f;  // |x| from which the top edges are sewn
+constexpr float kTorsoRadius = 0.15f, kTorsoHeight = 1.0f;
+// The seams' stiffness (N/m per pair): the peers' sewing springs, Blender's, have the structural
+// springs' 1000 N/m and no cap on their pull.
+constexpr float kSewSeamStiffness = 1000.0f;
+
+// Two panels of n x m particles, the front one's first, sewn at their sides and shoulders.
+ClothModel sewn_panels(const Fabric& fabric, uint32_t n, std::vector<std::array<uint32_t, 2>>& pairs) {
+  const uint32_t m = static_cast<uint32_t>(std::lround(kPanelHeight / kPanelWidth * static_cast<float>(n - 1))) + 1;
+  GridClothOptions panel;
+  panel.nx = n;
+  panel.ny = m;
+  panel.width = kPanelWidth;
+  panel.height = kPanelHeight;
+  panel.v_axis = Vec3f::UnitY();
+  // Front: ix from +x to -x (its triangles face -z, outwards); back: from -x to +x (facing +z).
+  panel.origin = Vec3f(0.5f * kPanelWidth, kPanelBottom, -kPanelOffset);
+  panel.u_axis = -Vec3f::UnitX();
+  ClothSpec spec = grid_cloth_spec(fabric, panel);
+  panel.origin = Vec3f(-0.5f * kPanelWidth, kPanelBottom, kPanelOffset);
+  panel.u_axis = Vec3f::UnitX();
+  ClothSpec back = grid_cloth_spec(fabric, panel);
+  const uint32_t off = n * m;
+  // The back panel beside the front one on the flat pattern (TEXCOORD_0).
+  for (Vec2f& f : back.flat_positions) f.x() += kPanelWidth + 0.1f;
+  spec.positions.insert(spec.positions.end(), back.positions.begin(), back.positions.end());
+  spec.flat_positions.insert(spec.flat_positions.end(), back.flat_positions.begin(), back.flat_positions.end());
+  spec.mass.insert(spec.mass.end(), back.mass.begin(), back.mass.end());
+  spec.drag_area.insert(spec.drag_area.end(), back.drag_area.begin(), back.drag_area.end());
+  for (const Tri& t : back.triangles) spec.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
+  for (ClothSpec::Spring sp : back.springs) {
+    sp.a += off;
+    sp.b += off;
+    spec.springs.push_back(sp);
+  }
+  for (ClothSpec::Bend bd : back.bends) {
+    bd.a += off;
+    bd.m += off;
+    bd.b += off;
+    spec.bends.push_back(bd);
+  }
+  spec.grid_nx = spec.grid_ny = 0;  // two grids: not one grid's indexing
+  // Front particle (i, j) lies at x = w/2 - i h, back particle (i', j) at -w/2 + i' h: the same x
+  // for i' = n - 1 - i.
+  const auto front = [&](uint32_t i, uint32_t j) { return j * n + i; };
+  const auto back_at = [&](uint32_t i, uint32_t j) { return off + j * n + (n - 1 - i); };
+  pairs.clear();
+  for (uint32_t j = 0; j < m; ++j) {
+    pairs.push_back({front(0, j), back_at(0, j)});
+    pairs.push_back({front(n - 1, j), back_at(n - 1, j)});
+  }
+  const float h = kPanelWidth / static_cast<float>(n - 1);
+  for (uint32_t i = 1; i + 1 < n; ++i)
+    if (std::abs(0.5f * kPanelWidth - static_cast<float>(i) * h) >= kShoulderFrom - 1e-6f)
+      pairs.push_back({front(i, m - 1), back_at(i, m - 1)});
+  for (const auto& [a, b] : pairs) spec.springs.push_back({a, b, 0.0f, kSewSeamStiffness, SpringKind::Seam});
+  return compile(std::move(spec));
+}
+
+}  // namespace
 
 ClothScene make_cloth_scene(const ClothSceneOptions& o) {
   if (o.n < 3 || o.n > 2048) throw InputError("--n", "the cloth needs between 3 and 2048 vertices per side");
@@ -23,7 +95,7 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
   grid.origin = Vec3f(-0.5f, 0.4f, -0.5f);
   grid.u_axis = Vec3f::UnitX();
   grid.v_axis = Vec3f::UnitZ();
-  s.model = grid_cloth(fabric, grid);
+  s.model = o.obstacle == SceneObstacle::Sew ? sewn_panels(fabric, o.n, s.seam_pairs) : grid_cloth(fabric, grid);
   s.state = initial_state(s.model);
   s.settings = default_step_settings(s.model);
   s.settings.strain_limit = o.strain_limit;
@@ -36,6 +108,8 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
   s.settings.time_step = o.time_step;
   if (o.obstacle == SceneObstacle::Sphere) {
     s.obstacles.push_back(std::make_unique<SphereCollider>(Vec3f::Zero(), 0.3f));
+  } else if (o.obstacle == SceneObstacle::Sew) {
+    s.obstacles.push_back(std::make_unique<CylinderCollider>(Vec3f(0.0f, kTorsoHeight, 0.0f), kTorsoRadius, kTorsoHeight));
   } else {
     s.obstacles.push_back(std::make_unique<BoxCollider>(Vec3f(0.0f, 0.28f, 0.0f), Vec3f(0.3f, 0.02f, 0.3f)));
     s.obstacles.push_back(std::make_unique<PlaneCollider>(Vec3f::Zero(), Vec3f::UnitY(), 2.0f));
@@ -52,6 +126,8 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
     // Dynamic steps as `drape animate` takes them. The sphere scene at n = 64: 8.2 s for its 2 s
     // against 14.3 s, the same strain and nothing inside (docs/benchmarks.md).
     sweep_dynamic_steps(s.implicit_settings);
+    s.implicit_settings.seam_stiffness = kSewSeamStiffness;
+    s.implicit_settings.seam_force = 0.0f;
   }
   return s;
 }
@@ -123,6 +199,13 @@ SceneQuality scene_quality(const ClothScene& scene) {
     }
   }
   q.penetration_fraction = scene.state.x.empty() ? 0.0 : static_cast<double>(q.penetrating_vertices) / static_cast<double>(scene.state.x.size());
+  double gaps = 0;
+  for (const auto& [a, b] : scene.seam_pairs) {
+    const float gap = (scene.state.x[a] - scene.state.x[b]).norm();
+    q.max_seam_gap = std::max(q.max_seam_gap, gap);
+    gaps += gap;
+  }
+  if (!scene.seam_pairs.empty()) q.mean_seam_gap = static_cast<float>(gaps / static_cast<double>(scene.seam_pairs.size()));
   return q;
 }
 

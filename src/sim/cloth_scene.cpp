@@ -28,6 +28,7 @@ constexpr float kTorsoRadius = 0.15f, kTorsoHeight = 1.0f;
 // The seams' stiffness (N/m per pair): the peers' sewing springs, Blender's, have the structural
 // springs' 1000 N/m and no cap on their pull.
 constexpr float kSewSeamStiffness = 1000.0f;
+constexpr uint32_t kMaxSewParticlesAcross = 256;
 
 // Two panels of n x m particles, the front one's first, sewn at their sides and shoulders.
 ClothModel sewn_panels(const Fabric& fabric, uint32_t n, std::vector<std::array<uint32_t, 2>>& pairs) {
@@ -86,6 +87,8 @@ ClothModel sewn_panels(const Fabric& fabric, uint32_t n, std::vector<std::array<
 
 ClothScene make_cloth_scene(const ClothSceneOptions& o) {
   if (o.n < 3 || o.n > 2048) throw InputError("--n", "the cloth needs between 3 and 2048 vertices per side");
+  if (o.obstacle == SceneObstacle::Sew && o.n > kMaxSewParticlesAcross)
+    throw InputError("sew scene", "at most 256 particles across a panel (2 x 256 x 307 in all)");
   if (o.strain_passes < 1 || o.strain_passes > 1000) throw InputError("--passes", "strain passes must be 1..1000");
   ClothScene s;
   const Fabric fabric = o.fabric.name.empty() ? fabric_or_throw("cotton") : o.fabric;

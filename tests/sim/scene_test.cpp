@@ -181,6 +181,10 @@ TEST(SceneCommand, BadOptionsExitWithStatus2AndWriteNothing) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("tweed"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "o"));
+  const auto big = test::run_drape("scene sew --n 300 --out " + (dir / "s").string());
+  EXPECT_EQ(big.exit_code, 2);
+  EXPECT_NE(big.err.find("256 particles across"), std::string::npos) << big.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "s"));
 }
 
 }  // namespace

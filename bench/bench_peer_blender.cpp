@@ -24,14 +24,11 @@
 #include <vector>
 
 #include "drape/cloth_scene.hpp"
+#include "peer_scene.hpp"
 
 namespace {
 
-constexpr double kSimulatedSeconds = 2.0;
-constexpr double kDensity = 0.2;   // kg/m^2
-constexpr double kFriction = 0.3;
-constexpr double kMargin = 0.01;   // m
-constexpr double kAirDrag = 1.0;   // 1/s
+using peer::kSimulatedSeconds;
 constexpr float kCalmSpeed = 0.05f;  // m/s: at rest once no particle moves faster (drape scene's criterion)
 
 struct Result {
@@ -43,18 +40,7 @@ struct Result {
 };
 
 Result run_drape(int n) {
-  drape::ClothSceneOptions options;
-  options.solver = drape::Solver::Implicit;
-  options.obstacle = drape::SceneObstacle::Sew;
-  options.n = static_cast<uint32_t>(n);
-  options.fabric = drape::fabric_or_throw("cotton");
-  options.fabric.areal_density = static_cast<float>(kDensity);
-  options.fabric.friction = static_cast<float>(kFriction);
-  options.fabric.collision_thickness = static_cast<float>(kMargin);
-  options.fabric.air_damping = static_cast<float>(kAirDrag);
-  options.fabric.air_drag = 0;
-  options.strain_threshold = 0.05f;
-  drape::ClothScene scene = drape::make_cloth_scene(options);
+  drape::ClothScene scene = drape::make_cloth_scene(peer::scene_options(drape::SceneObstacle::Sew, n, drape::Solver::Implicit));
   Result r;
   r.vertices = scene.model.particle_count();
   const auto start = std::chrono::steady_clock::now();

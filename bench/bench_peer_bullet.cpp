@@ -21,14 +21,15 @@
 #include <vector>
 
 #include "drape/cloth_scene.hpp"
+#include "peer_scene.hpp"
 
 namespace {
 
-constexpr double kSimulatedSeconds = 2.0;
-constexpr double kDensity = 0.2;     // kg/m^2
-constexpr double kFriction = 0.3;
-constexpr double kMargin = 0.01;     // m
-constexpr double kAirDrag = 1.0;     // 1/s
+using peer::kAirDrag;
+using peer::kDensity;
+using peer::kFriction;
+using peer::kMargin;
+using peer::kSimulatedSeconds;
 
 struct Result {
   double wall_seconds = 0;
@@ -111,19 +112,7 @@ Result run_bullet(int n) {
 
 // drape on the same scene (y up): cotton stiffness, the peers' mass, friction, margin and drag.
 Result run_drape(int n, drape::Solver solver = drape::Solver::Explicit) {
-  drape::ClothSceneOptions options;
-  options.solver = solver;
-  options.obstacle = drape::SceneObstacle::Sphere;
-  options.n = static_cast<uint32_t>(n);
-  options.fabric = drape::fabric_or_throw("cotton");
-  options.fabric.areal_density = static_cast<float>(kDensity);
-  options.fabric.friction = static_cast<float>(kFriction);
-  options.fabric.collision_thickness = static_cast<float>(kMargin);
-  options.fabric.air_damping = static_cast<float>(kAirDrag);
-  options.fabric.air_drag = 0;
-  options.strain_limit = drape::StrainLimit::Velocity;
-  options.strain_threshold = 0.05f;
-  drape::ClothScene scene = drape::make_cloth_scene(options);
+  drape::ClothScene scene = drape::make_cloth_scene(peer::scene_options(drape::SceneObstacle::Sphere, n, solver));
   const auto start = std::chrono::steady_clock::now();
   // The end of the 2 s within half a step (the implicit step's 1/30 s does not divide it exactly
   // in floating point).

@@ -145,6 +145,9 @@ struct ClothSpec {
   uint32_t grid_nx = 0, grid_ny = 0;
 };
 ClothModel compile(ClothSpec spec);
+// Appends `part` (another piece of cloth: a panel) to `into`, its indices moved past into's particles.
+// The two stay unjoined until springs between them (seams) are added. Returns the first index of part.
+uint32_t append(ClothSpec& into, const ClothSpec& part);
 
 // Rectangular-topology cloth (sec. 2.1): nx x ny particles over width x height metres, structural,
 // shear and flexion springs exactly as the paper lists them. The cloth lies in the plane spanned by

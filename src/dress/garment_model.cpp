@@ -94,18 +94,8 @@ GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh,
       // Triangle mesher: the cloth core's mesh springs, built on the flat panel, moved to 3D.
       Mesh m = panel.mesh;
       ClothSpec ps = mesh_cloth_spec(m, fabric, garment.source + ": panel '" + garment.panels[p].name + "'");
-      for (size_t i = 0; i < ps.positions.size(); ++i) {
-        spec.positions.push_back(x[i]);
-        spec.flat_positions.push_back(ps.flat_positions[i]);
-        spec.mass.push_back(ps.mass[i]);
-        spec.drag_area.push_back(ps.drag_area[i]);
-      }
-      for (const Tri& t : ps.triangles) spec.triangles.push_back({base + t[0], base + t[1], base + t[2]});
-      for (ClothSpec::Spring s : ps.springs) {
-        s.a += base;
-        s.b += base;
-        spec.springs.push_back(s);
-      }
+      append(spec, ps);
+      std::copy(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(ps.positions.size()), spec.positions.begin() + base);
     }
   }
   out.panel_first_vertex.push_back(static_cast<uint32_t>(spec.positions.size()));

@@ -263,6 +263,33 @@ ClothModel compile(ClothSpec spec) {
   return m;
 }
 
+uint32_t append(ClothSpec& into, const ClothSpec& part) {
+  const auto base = static_cast<uint32_t>(into.positions.size());
+  if (!into.pinned.empty() || !part.pinned.empty()) {
+    into.pinned.resize(base, 0);
+    if (part.pinned.empty()) into.pinned.resize(base + part.positions.size(), 0);
+    else into.pinned.insert(into.pinned.end(), part.pinned.begin(), part.pinned.end());
+  }
+  into.positions.insert(into.positions.end(), part.positions.begin(), part.positions.end());
+  into.flat_positions.insert(into.flat_positions.end(), part.flat_positions.begin(), part.flat_positions.end());
+  into.mass.insert(into.mass.end(), part.mass.begin(), part.mass.end());
+  into.drag_area.insert(into.drag_area.end(), part.drag_area.begin(), part.drag_area.end());
+  for (const Tri& t : part.triangles) into.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  for (ClothSpec::Spring sp : part.springs) {
+    sp.a += base;
+    sp.b += base;
+    into.springs.push_back(sp);
+  }
+  for (ClothSpec::Bend bd : part.bends) {
+    bd.a += base;
+    bd.m += base;
+    bd.b += base;
+    into.bends.push_back(bd);
+  }
+  into.grid_nx = into.grid_ny = 0;  // several pieces: not one grid's indexing
+  return base;
+}
+
 ClothSpec grid_cloth_spec(const Fabric& fabric, const GridClothOptions& o) {
   if (o.nx < 3 || o.ny < 3) throw InputError("--n", "a grid cloth needs at least 3 x 3 vertices");
   if (!(o.width > 0) || !(o.height > 0)) throw InputError("--size", "cloth width and height must be positive");

@@ -46,26 +46,9 @@ ClothModel sewn_panels(const Fabric& fabric, uint32_t n, std::vector<std::array<
   panel.origin = Vec3f(-0.5f * kPanelWidth, kPanelBottom, kPanelOffset);
   panel.u_axis = Vec3f::UnitX();
   ClothSpec back = grid_cloth_spec(fabric, panel);
-  const uint32_t off = n * m;
   // The back panel beside the front one on the flat pattern (TEXCOORD_0).
   for (Vec2f& f : back.flat_positions) f.x() += kPanelWidth + 0.1f;
-  spec.positions.insert(spec.positions.end(), back.positions.begin(), back.positions.end());
-  spec.flat_positions.insert(spec.flat_positions.end(), back.flat_positions.begin(), back.flat_positions.end());
-  spec.mass.insert(spec.mass.end(), back.mass.begin(), back.mass.end());
-  spec.drag_area.insert(spec.drag_area.end(), back.drag_area.begin(), back.drag_area.end());
-  for (const Tri& t : back.triangles) spec.triangles.push_back({t[0] + off, t[1] + off, t[2] + off});
-  for (ClothSpec::Spring sp : back.springs) {
-    sp.a += off;
-    sp.b += off;
-    spec.springs.push_back(sp);
-  }
-  for (ClothSpec::Bend bd : back.bends) {
-    bd.a += off;
-    bd.m += off;
-    bd.b += off;
-    spec.bends.push_back(bd);
-  }
-  spec.grid_nx = spec.grid_ny = 0;  // two grids: not one grid's indexing
+  const uint32_t off = append(spec, back);
   // Front particle (i, j) lies at x = w/2 - i h, back particle (i', j) at -w/2 + i' h: the same x
   // for i' = n - 1 - i.
   const auto front = [&](uint32_t i, uint32_t j) { return j * n + i; };

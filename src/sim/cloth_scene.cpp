@@ -113,6 +113,7 @@ ClothScene make_cloth_scene(const ClothSceneOptions& o) {
     // against 14.3 s, the same strain and nothing inside (docs/benchmarks.md).
     sweep_dynamic_steps(s.implicit_settings);
     s.implicit_settings.seam_stiffness = kSewSeamStiffness;
+    if (o.obstacle == SceneObstacle::Sew) s.implicit_settings.stiff_past_skin = false;
     s.implicit_settings.seam_force = 0.0f;
   }
   return s;

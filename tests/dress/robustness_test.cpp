@@ -2,9 +2,8 @@
 // different from the one the other tests dress from: the mesh's edge up to 10 % longer or shorter,
 // the whole placement moved up to 1 cm in a random direction. A single failure fails the case.
 // Two starts per case here; ten with --gtest_also_run_disabled_tests
-// (`build/tests/test_dress --gtest_also_run_disabled_tests --gtest_filter='*PerturbedStart*'`),
-// where on the shared bodies one start of the jeans M on the average man ends with its band's edge
-// in his skin, 8 of its 1,576 vertices (0.51 %; docs/dressing.md, "Status").
+// (`build/tests/test_dress --gtest_also_run_disabled_tests --gtest_filter='*PerturbedStart*'`;
+// docs/dressing.md, "Status").
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -62,10 +62,10 @@ TEST(SoftBodyDress, JeansPressTheBodyWhichKeepsItsVolume) {
 }
 
 // Jeans too small for the default male body (M, where his chart's size is XL: a 0.85 m waist on his
-// 0.87 m) press into him where he cannot give way; on the soft body his belly gives way under the
-// waistband and every gate passes (measured: 0.64 % of the vertices inside the rigid body, 0.43 %
-// inside the soft one, the gate 0.5 %; docs/soft-body.md).
-TEST(SoftBodyDress, JeansTooSmallPassOnTheSoftBodyWhereTheyPressIntoTheRigidOne) {
+// 0.87 m): on the rigid body the waistband rests past its strain limit with the contact layer
+// pressed thin and a seam nearly at the gate (measured: 2.44 % strain, 1.89 mm); on the soft body
+// his belly gives way under the waistband and the jeans ease (2.28 %, 1.08 mm; docs/soft-body.md).
+TEST(SoftBodyDress, JeansTooSmallEaseWhereTheSoftBodyGivesWay) {
   if (test::sanitized()) GTEST_SKIP() << "sanitized build: dressing is too slow";
   const Body& body = test::cached_body(Sex::Male);
   const GarmentSpec jeans = *builtin_garment("jeans");
@@ -75,6 +75,9 @@ TEST(SoftBodyDress, JeansTooSmallPassOnTheSoftBodyWhereTheyPressIntoTheRigidOne)
   const DressResult soft = dress(body, {GarmentRequest{jeans, "M"}}, o);
   ASSERT_TRUE(soft.soft_body);
   for (const GateResult& g : soft.gates) EXPECT_TRUE(g.passed) << g.name << ": " << g.detail;
+  EXPECT_GT(rigid.quality.max_strain, rigid.garments.at(0).model.fabric.strain_threshold) << "the band is at its limit on the rigid body";
+  EXPECT_LT(soft.quality.max_strain, rigid.quality.max_strain);
+  EXPECT_LT(soft.quality.max_seam_gap_m, rigid.quality.max_seam_gap_m);
   EXPECT_LE(soft.quality.penetrating_vertices, rigid.quality.penetrating_vertices);
   bool belly = false;
   for (const SoftRegionState& s : soft.soft_body->regions) {

@@ -94,8 +94,8 @@ GarmentCloth garment_cloth_spec(const Garment& garment, const GarmentMesh& mesh,
       // Triangle mesher: the cloth core's mesh springs, built on the flat panel, moved to 3D.
       Mesh m = panel.mesh;
       ClothSpec ps = mesh_cloth_spec(m, fabric, garment.source + ": panel '" + garment.panels[p].name + "'");
+      ps.positions.assign(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(ps.positions.size()));
       append(spec, ps);
-      std::copy(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(ps.positions.size()), spec.positions.begin() + base);
     }
   }
   out.panel_first_vertex.push_back(static_cast<uint32_t>(spec.positions.size()));

@@ -426,10 +426,9 @@ struct ImplicitSolver::Impl {
   bool exact = false;  // this iteration's springs: exact Hessian blocks (else projected)
   // Where the contact penalty stiffens kDeepContact-fold: the skin, or nowhere
   // (ImplicitSettings::stiff_past_skin).
-  double skin_depth = kNoSkin;
-  double skin() const { return skin_depth; }
+  double skin = kNoSkin;
   void set_skin(const ImplicitSettings& s) {
-    skin_depth = s.stiff_past_skin ? static_cast<double>(model.fabric.collision_thickness) : kNoSkin;
+    skin = s.stiff_past_skin ? static_cast<double>(model.fabric.collision_thickness) : kNoSkin;
   }
   // How far `p` is inside particle i's contact layer (thickness - distance to its plane).
   double depth(size_t i, const Vec3d& p) const {
@@ -763,7 +762,7 @@ void ImplicitSolver::Impl::lag_friction(const ImplicitSettings& s, bool at_step_
     // where the body dragged it).
     double d = depth(i, at_step_start ? x0[i] : x[i]);
     if (at_step_start) d -= plane_normal[i].dot(surface_velocity[i]);
-    friction_force[i] = in_range[i] ? mu * contact_force(contact_k[i], d, skin()) : 0.0;
+    friction_force[i] = in_range[i] ? mu * contact_force(contact_k[i], d, skin) : 0.0;
   }
 }
 
@@ -773,7 +772,7 @@ double ImplicitSolver::Impl::friction_lag_error(const ImplicitSettings& s) const
   double worst = 0;
   for (size_t i = 0; i < n; ++i) {
     if (!free[i]) continue;
-    const double now = in_range[i] ? mu * contact_force(contact_k[i], depth(i, x[i]), skin()) : 0.0;
+    const double now = in_range[i] ? mu * contact_force(contact_k[i], depth(i, x[i]), skin) : 0.0;
     worst = std::max(worst, std::abs(now - friction_force[i]) / (static_cast<double>(model.mass[i]) * gscale));
   }
   return worst;
@@ -793,8 +792,8 @@ double ImplicitSolver::Impl::energy(const std::vector<Vec3d>& at, const Implicit
       e += 0.5 * m.inertial_mass(i) * inv_h2 * (at[i] - y[i]).squaredNorm() - m.mass[i] * g.dot(at[i]);
       if (!in_range[i]) continue;
       const double pen = depth(i, at[i]);
-      if (pen > 0) e += contact_energy(contact_k[i], pen, skin());
-      if (in_crease[i]) e += contact_energy(contact_k[i], crease_depth(i, at[i]), skin());
+      if (pen > 0) e += contact_energy(contact_k[i], pen, skin);
+      if (in_crease[i]) e += contact_energy(contact_k[i], crease_depth(i, at[i]), skin);
       if (friction_force[i] > 0) {
         e += friction_energy(i, tangential_slip(i, at[i]).norm());
       }
@@ -1004,14 +1003,14 @@ void ImplicitSolver::Impl::assemble(const ImplicitSettings& s, double h) {
           const Vec3d& nrm = plane_normal[i];
           const double pen = depth(i, x[i]);
           if (pen > 0) {
-            grad -= contact_force(contact_k[i], pen, skin()) * nrm;
-            diag += contact_stiffness(contact_k[i], pen, skin()) * nrm * nrm.transpose();
+            grad -= contact_force(contact_k[i], pen, skin) * nrm;
+            diag += contact_stiffness(contact_k[i], pen, skin) * nrm * nrm.transpose();
           }
           const double crease = in_crease[i] ? crease_depth(i, x[i]) : 0.0;
           if (crease > 0) {
             const Vec3d& cn = crease_normal[i];
-            grad -= contact_force(contact_k[i], crease, skin()) * cn;
-            diag += contact_stiffness(contact_k[i], crease, skin()) * cn * cn.transpose();
+            grad -= contact_force(contact_k[i], crease, skin) * cn;
+            diag += contact_stiffness(contact_k[i], crease, skin) * cn * cn.transpose();
           }
           if (friction_force[i] > 0) {
             const Mat3d tangent = Mat3d::Identity() - nrm * nrm.transpose();
@@ -1217,19 +1216,19 @@ double ImplicitSolver::Impl::block_terms(size_t i, const Vec3d& p, const Implici
     const Vec3d& nrm = plane_normal[i];
     const double pen = depth(i, p);
     if (pen > 0) {
-      e += contact_energy(contact_k[i], pen, skin());
+      e += contact_energy(contact_k[i], pen, skin);
       if (grad) {
-        gr -= contact_force(contact_k[i], pen, skin()) * nrm;
-        h.add_outer(contact_stiffness(contact_k[i], pen, skin()), nrm);
+        gr -= contact_force(contact_k[i], pen, skin) * nrm;
+        h.add_outer(contact_stiffness(contact_k[i], pen, skin), nrm);
       }
     }
     const double crease = in_crease[i] ? crease_depth(i, p) : 0.0;
     if (crease > 0) {
       const Vec3d& cn = crease_normal[i];
-      e += contact_energy(contact_k[i], crease, skin());
+      e += contact_energy(contact_k[i], crease, skin);
       if (grad) {
-        gr -= contact_force(contact_k[i], crease, skin()) * cn;
-        h.add_outer(contact_stiffness(contact_k[i], crease, skin()), cn);
+        gr -= contact_force(contact_k[i], crease, skin) * cn;
+        h.add_outer(contact_stiffness(contact_k[i], crease, skin), cn);
       }
     }
     if (friction_force[i] > 0) {
@@ -1345,9 +1344,9 @@ float ImplicitSolver::Impl::residual(const ImplicitSettings& s) {
     if (in_range[i]) {
       const Vec3d& nrm = plane_normal[i];
       const double pen = depth(i, x[i]);
-      const double normal_force = contact_force(contact_k[i], pen, skin());
+      const double normal_force = contact_force(contact_k[i], pen, skin);
       force += normal_force * nrm;
-      if (in_crease[i]) force += contact_force(contact_k[i], crease_depth(i, x[i]), skin()) * crease_normal[i];
+      if (in_crease[i]) force += contact_force(contact_k[i], crease_depth(i, x[i]), skin) * crease_normal[i];
       if (normal_force > 0) {
         // Static friction takes up to mu N of the tangential force.
         const Vec3d tangential = force - nrm.dot(force) * nrm;
@@ -1389,8 +1388,8 @@ void ImplicitSolver::contact_forces(std::span<Vec3f> force, std::span<Vec3f> poi
     if (!w.free[i] || !w.in_range[i] || !w.planes_valid) continue;
     const Vec3d& nrm = w.plane_normal[i];
     const Vec3d& x = w.x[i];
-    Vec3d f = contact_force(w.contact_k[i], w.depth(i, x), w.skin()) * nrm;
-    if (w.in_crease[i]) f += contact_force(w.contact_k[i], w.crease_depth(i, x), w.skin()) * w.crease_normal[i];
+    Vec3d f = contact_force(w.contact_k[i], w.depth(i, x), w.skin) * nrm;
+    if (w.in_crease[i]) f += contact_force(w.contact_k[i], w.crease_depth(i, x), w.skin) * w.crease_normal[i];
     if (w.friction_force[i] > 0) {
       // Minus the friction energy's gradient (assemble()).
       const Vec3d u = w.tangential_slip(i, x);

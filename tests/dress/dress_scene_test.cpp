@@ -78,17 +78,15 @@ TEST(DressScene, DefaultShirtOnDefaultBodyPassesTheGates) {
 }
 
 // Self-contact (DressOptions::self_collision, docs/cloth.md): the default shirt and the dress
-// draped with it pass through themselves nowhere; the shirt draped without it does (8 edges
-// through its own triangles, where the sleeves fold against the sides).
+// draped with it pass through themselves nowhere. (Whether the shirt draped without it passes
+// through itself where the sleeves fold against the sides depends on rounding: 8 edges or none
+// from one build of the solver to the next. Self-contact's own effect is asserted on two sheets
+// in tests/sim/implicit_test.cpp.)
 TEST(DressScene, GarmentsDrapedWithSelfContactDoNotPassThroughThemselves) {
   const DressResult& shirt = default_dressing();
   ASSERT_EQ(shirt.garments.size(), 1u);
   EXPECT_EQ(shirt.garments[0].self_intersections, 0u);
   if (sanitized()) GTEST_SKIP() << "sanitized build: the default shirt only";
-  DressOptions o;
-  o.self_collision = false;
-  const DressResult without = dress(cached_body(Sex::Female), {{load_garment(default_garment_name()), ""}}, o);
-  EXPECT_GT(without.garments[0].self_intersections, 0u);
   const DressResult dress_m = dress(cached_body(Sex::Female), {{load_garment("dress"), "M"}});
   EXPECT_TRUE(dress_m.passed()) << failed_gates(dress_m);
   EXPECT_EQ(dress_m.garments[0].self_intersections, 0u);

@@ -7,7 +7,7 @@ packages=(
   cmake make g++ lld pkg-config git ca-certificates
   clang-14 libclang-rt-14-dev clang-format clang-tidy   # fuzzing (libFuzzer) and the style configs
   libeigen3-dev libsuitesparse-dev nlohmann-json3-dev libfmt-dev libcli11-dev
-  libopenblas0-pthread                                  # CHOLMOD's dense kernels: 3x the reference BLAS
+  libblas-dev liblapack-dev libopenblas0-pthread        # dense kernels (CHOLMOD, the solver): OpenBLAS 3x the reference
   libtinygltf-dev libtinyobjloader-dev libstb-dev
   libembree-dev libtbb-dev libcgal-dev libgmp-dev libmpfr-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -30,6 +30,7 @@
 
 #include "sim/parallel.hpp"
 #include "sim/self_contact.hpp"
+#include "sim/supernodal.hpp"
 
 namespace drape {
 namespace {
@@ -206,6 +207,34 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
     out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x_->x), rhs.size());
   }
 
+  // After analyzePattern: the factor's values allocated, and the factorisation on both cores
+  // prepared where its pattern allows (sim::SupernodalFactorisation).
+  void prepare_factorisation(const SparseMatrix& a) {
+    parallel_.clear();
+    cholmod_factor* f = m_cholmodFactor;
+    if (!f || !f->is_super) return;
+    if (!cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, f, &cholmod()) || f->xtype != CHOLMOD_REAL ||
+        !f->x || !f->is_ll)
+      return;
+    parallel_.analyse(*f, a.outerIndexPtr(), a.innerIndexPtr());
+  }
+  // factorize(a), with the subtrees of its elimination tree on up to `threads` threads (the same
+  // factor to the bit on any number).
+  void factorise(const SparseMatrix& a, int threads) {
+    if (!parallel_.ready()) {
+      const CholmodCall call;
+      factorize(a);
+      return;
+    }
+    std::unique_lock<std::mutex> hold;
+    if (!blas_takes_concurrent_calls()) {
+      hold = std::unique_lock(blas_lock());
+      threads = 1;
+    }
+    m_info = parallel_.factorise(*m_cholmodFactor, a.valuePtr(), threads) ? Eigen::Success : Eigen::NumericalIssue;
+    m_factorizationIsOk = true;
+  }
+
   // The factor's values rounded to single precision for solve_single, after each factorize (a
   // factor CHOLMOD did not make supernodal is solved by solve_into).
   void round_factor() {
@@ -264,6 +293,7 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
  private:
   cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // result and workspace
   std::vector<float> single_, work_, gather_;
+  sim::SupernodalFactorisation parallel_;
 };
 
 double now() {
@@ -758,6 +788,7 @@ void ImplicitSolver::Impl::analyse_pattern() {
     c.nrelax[2] = kRelaxFewZeros;
     cholesky.analyzePattern(matrix);
     cholesky.forget_single();
+    cholesky.prepare_factorisation(matrix);
   }
 }
 
@@ -1606,16 +1637,12 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     cg_missed = s.direction_tolerance < ImplicitSettings::kLooseDirection && (cg_missed || (w.factored && !solved));
     timer.mark(profile ? profile->solve : scratch_time);
     if (!solved) {
-      {
-        const CholmodCall call;
-        w.cholesky.factorize(w.matrix);
-      }
+      w.cholesky.factorise(w.matrix, omp_get_max_threads());
       if (w.cholesky.info() != Eigen::Success && w.exact) {
         if (profile) ++profile->factorizations;
         w.exact = false;
         w.assemble(s, hd);
-        const CholmodCall call;
-        w.cholesky.factorize(w.matrix);
+        w.cholesky.factorise(w.matrix, omp_get_max_threads());
       }
       if (w.cholesky.info() == Eigen::Success) w.cholesky.round_factor();
       timer.mark(profile ? profile->factorize : scratch_time);

@@ -1,0 +1,284 @@
+#include "sim/supernodal.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <numeric>
+
+// The reference BLAS and LAPACK interface (OpenBLAS behind it where the system has it); the string
+// lengths gfortran passes last.
+extern "C" {
+void dsyrk_(const char* uplo, const char* trans, const int* n, const int* k, const double* alpha, const double* a,
+            const int* lda, const double* beta, double* c, const int* ldc, size_t, size_t);
+void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
+            const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
+            const int* ldc, size_t, size_t);
+void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+            const double* alpha, const double* a, const int* lda, double* b, const int* ldb, size_t, size_t, size_t,
+            size_t);
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info, size_t);
+}
+
+namespace drape::sim {
+namespace {
+
+// A partition is good enough once its largest part holds at most this much over an even share.
+constexpr double kBalance = 1.05;
+
+struct View {
+  const int *super, *pi, *px, *rows;
+  explicit View(const cholmod_factor& f)
+      : super(static_cast<const int*>(f.super)), pi(static_cast<const int*>(f.pi)),
+        px(static_cast<const int*>(f.px)), rows(static_cast<const int*>(f.s)) {}
+  int columns(int s) const { return super[s + 1] - super[s]; }
+  int height(int s) const { return pi[s + 1] - pi[s]; }
+};
+
+}  // namespace
+
+bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer, const int* inner) {
+  ready_ = false;
+  if (!f.is_super || !f.is_ll || f.itype != CHOLMOD_INT || f.nsuper == 0) return false;
+  const View v(f);
+  n_ = static_cast<int>(f.n);
+  nsuper_ = static_cast<int>(f.nsuper);
+  std::vector<int> column_super(static_cast<size_t>(n_));
+  for (int s = 0; s < nsuper_; ++s) {
+    const int* r = v.rows + v.pi[s];
+    for (int k = 0; k < v.height(s); ++k)
+      if ((k < v.columns(s) && r[k] != v.super[s] + k) || (k > 0 && r[k] <= r[k - 1])) return false;
+    for (int k = v.super[s]; k < v.super[s + 1]; ++k) column_super[static_cast<size_t>(k)] = s;
+  }
+  // A's lower entries, each to its place in its supernode's block (P A P^T's lower triangle).
+  const int* perm = static_cast<const int*>(f.Perm);
+  std::vector<int> inverse(static_cast<size_t>(n_));
+  for (int k = 0; k < n_; ++k) inverse[static_cast<size_t>(perm[k])] = k;
+  std::vector<std::array<uint32_t, 3>> placed;  // supernode, value index, block index
+  for (int j = 0; j < n_; ++j)
+    for (int q = outer[j]; q < outer[j + 1]; ++q) {
+      const int i = inner[q];
+      if (i < j) continue;
+      const int a = inverse[static_cast<size_t>(i)], b = inverse[static_cast<size_t>(j)];
+      const int col = std::min(a, b), row = std::max(a, b), s = column_super[static_cast<size_t>(col)];
+      const int* r = v.rows + v.pi[s];
+      const int* at = std::lower_bound(r, r + v.height(s), row);
+      if (at == r + v.height(s) || *at != row) return false;
+      placed.push_back({static_cast<uint32_t>(s), static_cast<uint32_t>(q),
+                        static_cast<uint32_t>((col - v.super[s]) * v.height(s) + (at - r))});
+    }
+  std::stable_sort(placed.begin(), placed.end(), [](const auto& x, const auto& y) { return x[0] < y[0]; });
+  entry_begin_.assign(static_cast<size_t>(nsuper_) + 1, 0);
+  entries_.clear();
+  for (const auto& [s, q, at] : placed) {
+    ++entry_begin_[s + 1];
+    entries_.emplace_back(q, at);
+  }
+  std::partial_sum(entry_begin_.begin(), entry_begin_.end(), entry_begin_.begin());
+
+  // Each supernode's updates, from the supernodes below whose rows reach its columns, in order; the
+  // elimination tree (a supernode's parent: the one its first row below reaches); the flops.
+  std::vector<std::vector<Update>> into(static_cast<size_t>(nsuper_));
+  std::vector<int> parent(static_cast<size_t>(nsuper_), -1);
+  std::vector<double> flops(static_cast<size_t>(nsuper_), 0.0);
+  size_t largest_update = 1;
+  for (int d = 0; d < nsuper_; ++d) {
+    const double c = v.columns(d), below = v.height(d) - v.columns(d);
+    flops[static_cast<size_t>(d)] += c * c * c / 3 + c * c * below;
+    const int* r = v.rows + v.pi[d];
+    for (int p = v.columns(d); p < v.height(d);) {
+      const int s = column_super[static_cast<size_t>(r[p])], first = p;
+      while (p < v.height(d) && r[p] < v.super[s + 1]) ++p;
+      if (parent[static_cast<size_t>(d)] < 0) parent[static_cast<size_t>(d)] = s;
+      into[static_cast<size_t>(s)].push_back({d, first, p});
+      const size_t rows_reached = static_cast<size_t>(v.height(d) - first), columns_reached = static_cast<size_t>(p - first);
+      largest_update = std::max(largest_update, rows_reached * columns_reached);
+      flops[static_cast<size_t>(s)] += static_cast<double>(rows_reached * columns_reached) * c;
+    }
+  }
+  update_begin_.assign(static_cast<size_t>(nsuper_) + 1, 0);
+  updates_.clear();
+  for (int s = 0; s < nsuper_; ++s) {
+    updates_.insert(updates_.end(), into[static_cast<size_t>(s)].begin(), into[static_cast<size_t>(s)].end());
+    update_begin_[static_cast<size_t>(s) + 1] = static_cast<uint32_t>(updates_.size());
+  }
+
+  // The parts: from the roots down, the costliest subtree gives its root to the top and its children
+  // to the frontier, until the frontier's subtrees deal (largest first, each to the lightest part)
+  // into parts within kBalance of even.
+  std::vector<double> subtree(flops);
+  std::vector<std::vector<int>> children(static_cast<size_t>(nsuper_));
+  std::vector<int> frontier;
+  for (int s = 0; s < nsuper_; ++s) {
+    const int up = parent[static_cast<size_t>(s)];
+    if (up < 0) {
+      frontier.push_back(s);
+      continue;
+    }
+    subtree[static_cast<size_t>(up)] += subtree[static_cast<size_t>(s)];
+    children[static_cast<size_t>(up)].push_back(s);
+  }
+  part_.assign(static_cast<size_t>(nsuper_), -1);
+  std::vector<int> root_part;
+  for (;;) {
+    std::sort(frontier.begin(), frontier.end(), [&](int x, int y) {
+      return subtree[static_cast<size_t>(x)] != subtree[static_cast<size_t>(y)] ? subtree[static_cast<size_t>(x)] > subtree[static_cast<size_t>(y)] : x < y;
+    });
+    std::array<double, kParts> load{};
+    root_part.assign(frontier.size(), 0);
+    double total = 0;
+    for (size_t k = 0; k < frontier.size(); ++k) {
+      const auto lightest = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      root_part[k] = lightest;
+      load[static_cast<size_t>(lightest)] += subtree[static_cast<size_t>(frontier[k])];
+      total += subtree[static_cast<size_t>(frontier[k])];
+    }
+    const double heaviest = *std::max_element(load.begin(), load.end());
+    if (frontier.empty() || heaviest <= kBalance * total / kParts || children[static_cast<size_t>(frontier[0])].empty()) break;
+    const int root = frontier[0];
+    frontier.erase(frontier.begin());
+    for (const int c : children[static_cast<size_t>(root)]) frontier.push_back(c);
+  }
+  // Each frontier subtree's supernodes take its part; the rest are the top (parents come after
+  // their children, so each supernode's is settled before theirs).
+  std::vector<char> is_root(static_cast<size_t>(nsuper_), 0);
+  for (size_t k = 0; k < frontier.size(); ++k) {
+    is_root[static_cast<size_t>(frontier[k])] = 1;
+    part_[static_cast<size_t>(frontier[k])] = root_part[k];
+  }
+  for (int s = nsuper_ - 1; s >= 0; --s) {
+    const int up = parent[static_cast<size_t>(s)];
+    if (!is_root[static_cast<size_t>(s)]) part_[static_cast<size_t>(s)] = up < 0 ? -1 : part_[static_cast<size_t>(up)];
+  }
+  part_nodes_.assign(kParts, {});
+  top_nodes_.clear();
+  double top_flops = 0, all_flops = 0;
+  for (int s = 0; s < nsuper_; ++s) {
+    all_flops += flops[static_cast<size_t>(s)];
+    if (part_[static_cast<size_t>(s)] < 0) {
+      top_nodes_.push_back(s);
+      top_flops += flops[static_cast<size_t>(s)];
+    } else {
+      part_nodes_[static_cast<size_t>(part_[static_cast<size_t>(s)])].push_back(s);
+    }
+  }
+  // The updates from a part to a top supernode are the part's work: back out of the top's share.
+  for (const int s : top_nodes_)
+    for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
+      const Update& u = updates_[k];
+      if (part_[static_cast<size_t>(u.from)] >= 0)
+        top_flops -= static_cast<double>(v.height(u.from) - u.first) * (u.end - u.first) * v.columns(u.from);
+    }
+  top_share_ = all_flops > 0 ? top_flops / all_flops : 0;
+
+  // Where each part sums its updates to each top supernode.
+  sum_offset_.assign(static_cast<size_t>(kParts) * static_cast<size_t>(nsuper_), SIZE_MAX);
+  size_t size = 0;
+  for (const int s : top_nodes_)
+    for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
+      const int p = part_[static_cast<size_t>(updates_[k].from)];
+      size_t& at = sum_offset_[static_cast<size_t>(p < 0 ? 0 : p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+      if (p < 0 || at != SIZE_MAX) continue;
+      at = size;
+      size += static_cast<size_t>(v.height(s)) * static_cast<size_t>(v.columns(s));
+    }
+  sums_.assign(size, 0.0);
+  work_.resize(kParts);
+  for (Workspace& w : work_) {
+    w.relative.assign(static_cast<size_t>(n_), 0);
+    w.update.assign(largest_update, 0.0);
+  }
+  ready_ = true;
+  return true;
+}
+
+void SupernodalFactorisation::apply(const cholmod_factor& f, int s, const Update& u, double* target, double sign,
+                                    Workspace& work) const {
+  const View v(f);
+  const double* x = static_cast<const double*>(f.x);
+  const int d = u.from, columns = v.columns(d), height = v.height(d);
+  const int reached = u.end - u.first, rows = height - u.first, rest = rows - reached;
+  const double* l = x + v.px[d];
+  double* c = work.update.data();
+  const double one = 1, zero = 0;
+  dsyrk_("L", "N", &reached, &columns, &one, l + u.first, &height, &zero, c, &rows, 1, 1);
+  if (rest > 0)
+    dgemm_("N", "T", &rest, &reached, &columns, &one, l + u.end, &height, l + u.first, &height, &zero, c + reached, &rows,
+           1, 1);
+  const int* r = v.rows + v.pi[d] + u.first;
+  const int first_column = v.super[s], target_height = v.height(s);
+  const int* relative = work.relative.data();
+  for (int j = 0; j < reached; ++j) {
+    double* t = target + static_cast<size_t>(r[j] - first_column) * static_cast<size_t>(target_height);
+    const double* cj = c + static_cast<size_t>(j) * static_cast<size_t>(rows);
+    for (int i = j; i < rows; ++i) t[relative[r[i]]] += sign * cj[i];
+  }
+}
+
+void SupernodalFactorisation::sum_updates(const cholmod_factor& f, int s, int part, double* into, Workspace& work) const {
+  const View v(f);
+  for (int k = 0; k < v.height(s); ++k) work.relative[static_cast<size_t>(v.rows[v.pi[s] + k])] = k;
+  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k)
+    if (part_[static_cast<size_t>(updates_[k].from)] == part) apply(f, s, updates_[k], into, 1.0, work);
+}
+
+int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* values, Workspace& work) const {
+  const View v(f);
+  const int columns = v.columns(s), height = v.height(s), below = height - columns;
+  double* l = static_cast<double*>(f.x) + v.px[s];
+  const size_t size = static_cast<size_t>(height) * static_cast<size_t>(columns);
+  std::fill(l, l + size, 0.0);
+  for (uint32_t k = entry_begin_[static_cast<size_t>(s)]; k < entry_begin_[static_cast<size_t>(s) + 1]; ++k)
+    l[entries_[k].second] += values[entries_[k].first];
+  const int part = part_[static_cast<size_t>(s)];
+  if (part < 0)
+    for (int p = 0; p < kParts; ++p) {
+      const size_t at = sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+      if (at == SIZE_MAX) continue;
+      const double* sum = sums_.data() + at;
+      for (size_t k = 0; k < size; ++k) l[k] -= sum[k];
+    }
+  for (int k = 0; k < height; ++k) work.relative[static_cast<size_t>(v.rows[v.pi[s] + k])] = k;
+  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k)
+    if (part_[static_cast<size_t>(updates_[k].from)] == part) apply(f, s, updates_[k], l, -1.0, work);
+  int info = 0;
+  dpotrf_("L", &columns, l, &height, &info, 1);
+  if (info != 0) return v.super[s] + info - 1;
+  if (below > 0) {
+    const double one = 1;
+    dtrsm_("R", "L", "T", "N", &below, &columns, &one, l, &height, l + columns, &height, 1, 1, 1, 1);
+  }
+  return -1;
+}
+
+bool SupernodalFactorisation::factorise(cholmod_factor& f, const double* values, int threads) {
+  std::array<int, kParts> failed;  // per part: the column it failed at, or -1
+  failed.fill(-1);
+  std::fill(sums_.begin(), sums_.end(), 0.0);
+#pragma omp parallel for num_threads(std::max(1, std::min(threads, kParts))) schedule(static, 1)
+  for (int p = 0; p < kParts; ++p) {
+    Workspace& work = work_[static_cast<size_t>(p)];
+    for (const int s : part_nodes_[static_cast<size_t>(p)])
+      if ((failed[static_cast<size_t>(p)] = supernode(f, s, values, work)) >= 0) break;
+    if (failed[static_cast<size_t>(p)] < 0)
+      for (const int s : top_nodes_) {
+        const size_t at = sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+        if (at != SIZE_MAX) sum_updates(f, s, p, sums_.data() + at, work);
+      }
+  }
+  // The matrix not positive definite: f.minor = the first part's column that failed.
+  for (const int column : failed)
+    if (column >= 0) {
+      f.minor = static_cast<size_t>(column);
+      return false;
+    }
+  for (const int s : top_nodes_)
+    if (const int column = supernode(f, s, values, work_[0]); column >= 0) {
+      f.minor = static_cast<size_t>(column);
+      return false;
+    }
+  f.minor = f.n;
+  return true;
+}
+
+}  // namespace drape::sim

@@ -1,0 +1,78 @@
+#pragma once
+// The numeric supernodal Cholesky factorisation on CHOLMOD's symbolic analysis, its independent
+// subtrees on both cores.
+//
+// CHOLMOD 3 (Debian 12) factorises supernode after supernode on one thread (its OpenMP regions,
+// one per large supernode, cost more than they give on two cores; OpenBLAS's own threads inside the
+// factorisation likewise, and change its rounding with the thread count: docs/cloth.md). The
+// elimination tree of a nested-dissection ordering splits below its top separators into subtrees
+// that share nothing: this factorises them side by side. It is written here because no library of
+// Debian's does it with results independent of the thread count.
+//
+// Left-looking, as CHOLMOD's own: a supernode's columns are A's, less the updates of the
+// supernodes below it that reach its rows (the BLAS's dsyrk and dgemm on their dense blocks),
+// then dpotrf on its diagonal block and dtrsm on the rows below. The supernodes are dealt into
+// kParts parts (whole subtrees, balanced by their flops) and the top (the separators above them):
+// each part is factorised on its own, with the sum of its updates to each top supernode; then the
+// top, in order, each top supernode taking the parts' sums in part order. The parts are fixed by
+// the pattern, so the arithmetic, and the factor to the bit, are the same on any number of threads.
+#include <cholmod.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace drape::sim {
+
+class SupernodalFactorisation {
+ public:
+  static constexpr int kParts = 2;
+
+  // Prepares for a supernodal LL^T symbolic factor `f` of the n x n symmetric matrix whose
+  // compressed columns are (outer, inner) (both triangles or the lower one: entries above the
+  // diagonal are not read). False where `f` is not such a factor (its rows unsorted).
+  bool analyse(const cholmod_factor& f, const int* outer, const int* inner);
+  bool ready() const { return ready_; }
+  void clear() { ready_ = false; }
+
+  // f's values = the factor of the matrix with these values (in the pattern given to analyse);
+  // f must be the factor analysed, its values allocated. False where the matrix is not positive
+  // definite (f->minor = the first column it failed at). `threads` 1 runs everything on the caller.
+  bool factorise(cholmod_factor& f, const double* values, int threads);
+
+  // The share of the flops outside the parts (on one thread), for the documentation's measurements.
+  double top_share() const { return top_share_; }
+
+ private:
+  struct Update {
+    int from, first, end;  // the supernode below, and the range of its rows in this one's columns
+  };
+  struct Workspace {
+    std::vector<int> relative;  // a row's position in the supernode being factorised
+    std::vector<double> update;
+  };
+  // Factorises supernode s into its block of f's values: -1, or the column where dpotrf found the
+  // matrix not positive definite.
+  int supernode(cholmod_factor& f, int s, const double* values, Workspace& work) const;
+  // The updates of part's supernodes to the top supernode s, summed into `into` (s's block's shape).
+  void sum_updates(const cholmod_factor& f, int s, int part, double* into, Workspace& work) const;
+  // target += sign * (update u to supernode s), on s's rows (work.relative set for s).
+  void apply(const cholmod_factor& f, int s, const Update& u, double* target, double sign, Workspace& work) const;
+
+  bool ready_ = false;
+  int n_ = 0, nsuper_ = 0;
+  double top_share_ = 0;
+  std::vector<int> part_;                    // per supernode: its part, or -1 (the top)
+  std::vector<std::vector<int>> part_nodes_;  // per part: its supernodes in order
+  std::vector<int> top_nodes_;
+  std::vector<uint32_t> update_begin_;  // per supernode: its updates (from the supernodes below, in order)
+  std::vector<Update> updates_;
+  std::vector<uint32_t> entry_begin_;  // per supernode: A's lower entries in its columns
+  std::vector<std::pair<uint32_t, uint32_t>> entries_;  // (index in A's values, index in its block)
+  std::vector<size_t> sum_offset_;     // per (part, top supernode): its sum of updates in sums_
+  std::vector<double> sums_;
+  std::vector<Workspace> work_;
+};
+
+}  // namespace drape::sim

@@ -1,0 +1,157 @@
+// The supernodal factorisation on both cores (src/sim/supernodal.hpp): the factor solves the system
+// as CHOLMOD's does, it is the same to the bit on one thread and on two, and a matrix that is not
+// positive definite is found out.
+#include "sim/supernodal.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Sparse>
+#include <cstring>
+#include <random>
+#include <vector>
+
+namespace drape::sim {
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// A cloth-like matrix: a grid of side x side particles, 3 unknowns each, a mass on the diagonal
+// and a spring's stiffness k (I + u u^T) between neighbours, diagonals included (both triangles
+// stored, as the implicit solver stores its Hessian).
+Sparse grid_matrix(int side, uint32_t seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> stiffness(10.0, 1000.0), component(-1.0, 1.0);
+  const int n = side * side;
+  std::vector<Eigen::Triplet<double>> t;
+  const auto couple = [&](int a, int b) {
+    Eigen::Vector3d u(component(random), component(random), component(random));
+    u.normalize();
+    const Eigen::Matrix3d block = stiffness(random) * (Eigen::Matrix3d::Identity() + u * u.transpose());
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        t.emplace_back(3 * a + i, 3 * a + j, block(i, j));
+        t.emplace_back(3 * b + i, 3 * b + j, block(i, j));
+        t.emplace_back(3 * a + i, 3 * b + j, -block(i, j));
+        t.emplace_back(3 * b + i, 3 * a + j, -block(i, j));
+      }
+  };
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const int p = y * side + x;
+      for (int i = 0; i < 3; ++i) t.emplace_back(3 * p + i, 3 * p + i, 1.0);
+      if (x + 1 < side) couple(p, p + 1);
+      if (y + 1 < side) couple(p, p + side);
+      if (x + 1 < side && y + 1 < side) couple(p, p + side + 1);
+      if (x > 0 && y + 1 < side) couple(p, p + side - 1);
+    }
+  Sparse a(3 * n, 3 * n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  return a;
+}
+
+class Factor {
+ public:
+  explicit Factor(Sparse& a) {
+    cholmod_start(&common_);
+    common_.supernodal = CHOLMOD_SUPERNODAL;
+    common_.print = 0;
+    view_.nrow = view_.ncol = static_cast<size_t>(a.rows());
+    view_.nzmax = static_cast<size_t>(a.nonZeros());
+    view_.p = a.outerIndexPtr();
+    view_.i = a.innerIndexPtr();
+    view_.x = a.valuePtr();
+    view_.stype = -1;  // the lower triangle
+    view_.itype = CHOLMOD_INT;
+    view_.xtype = CHOLMOD_REAL;
+    view_.dtype = CHOLMOD_DOUBLE;
+    view_.sorted = view_.packed = 1;
+    symbolic_ = cholmod_analyze(&view_, &common_);
+  }
+  ~Factor() {
+    cholmod_free_factor(&symbolic_, &common_);
+    cholmod_finish(&common_);
+  }
+  Factor(const Factor&) = delete;
+  Factor& operator=(const Factor&) = delete;
+
+  // CHOLMOD's own factor, or one with SupernodalFactorisation on `threads` threads.
+  cholmod_factor* cholmod() {
+    cholmod_factor* f = cholmod_copy_factor(symbolic_, &common_);
+    cholmod_factorize(&view_, f, &common_);
+    return f;
+  }
+  cholmod_factor* ours(const Sparse& a, int threads, bool* positive = nullptr, double* top = nullptr) {
+    cholmod_factor* f = cholmod_copy_factor(symbolic_, &common_);
+    cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, f, &common_);
+    SupernodalFactorisation s;
+    EXPECT_TRUE(s.analyse(*f, a.outerIndexPtr(), a.innerIndexPtr()));
+    const bool ok = s.factorise(*f, a.valuePtr(), threads);
+    if (positive) *positive = ok;
+    if (top) *top = s.top_share();
+    return f;
+  }
+  // |A x - b| / |b| for x solved with f.
+  double residual(cholmod_factor* f, const Sparse& a) {
+    Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(a.rows(), -1.0, 2.0);
+    cholmod_dense rhs = Eigen::viewAsCholmod(b);
+    cholmod_dense* x = cholmod_solve(CHOLMOD_A, f, &rhs, &common_);
+    const Eigen::VectorXd solution = Eigen::Map<Eigen::VectorXd>(static_cast<double*>(x->x), a.rows());
+    cholmod_free_dense(&x, &common_);
+    const Eigen::VectorXd full = a.selfadjointView<Eigen::Lower>() * solution;
+    return (full - b).norm() / b.norm();
+  }
+  void free(cholmod_factor* f) { cholmod_free_factor(&f, &common_); }
+
+ private:
+  cholmod_common common_{};
+  cholmod_sparse view_{};
+  cholmod_factor* symbolic_ = nullptr;
+};
+
+TEST(SupernodalFactorisation, SolvesAsCholmodDoes) {
+  for (const int side : {6, 30}) {
+    Sparse a = grid_matrix(side, 7u + static_cast<uint32_t>(side));
+    Factor factor(a);
+    cholmod_factor* theirs = factor.cholmod();
+    bool positive = false;
+    double top = 1;
+    cholmod_factor* ours = factor.ours(a, 2, &positive, &top);
+    EXPECT_TRUE(positive);
+    EXPECT_EQ(ours->minor, ours->n);
+    EXPECT_LT(factor.residual(theirs, a), 1e-12);
+    EXPECT_LT(factor.residual(ours, a), 1e-12) << "side " << side;
+    if (side == 30) {
+      EXPECT_LT(top, 0.5) << "the subtrees below the top separators should hold most of the work";
+    }
+    factor.free(theirs);
+    factor.free(ours);
+  }
+}
+
+TEST(SupernodalFactorisation, SameFactorBitForBitOnOneAndTwoThreads) {
+  Sparse a = grid_matrix(40, 3u);
+  Factor factor(a);
+  cholmod_factor* one = factor.ours(a, 1);
+  cholmod_factor* two = factor.ours(a, 2);
+  ASSERT_EQ(one->xsize, two->xsize);
+  EXPECT_EQ(std::memcmp(one->x, two->x, one->xsize * sizeof(double)), 0);
+  factor.free(one);
+  factor.free(two);
+}
+
+TEST(SupernodalFactorisation, FindsAMatrixThatIsNotPositiveDefinite) {
+  Sparse a = grid_matrix(30, 5u);
+  // One unknown's diagonal far below what its springs need.
+  a.coeffRef(1000, 1000) = -1e6;
+  Factor factor(a);
+  bool positive = true;
+  cholmod_factor* ours = factor.ours(a, 2, &positive);
+  EXPECT_FALSE(positive);
+  EXPECT_LT(ours->minor, ours->n);
+  factor.free(ours);
+}
+
+}  // namespace
+}  // namespace drape::sim

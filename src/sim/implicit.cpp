@@ -178,17 +178,12 @@ class CholmodCall {
   std::unique_lock<std::mutex> hold_;
 };
 
-// CHOLMOD's supernodal factorisation, solving into storage kept from call to call: Eigen's solve()
-// has CHOLMOD allocate the result and its workspace at every call, and copies the result out;
-// cholmod_solve2 reuses them, so a step's triangular solves allocate nothing.
-//
-// The triangular solves run on a single-precision copy of the factor (solve_single), written here
-// because CHOLMOD 3 (Debian 12) factorises and solves in double precision only. The factor is the
-// conjugate gradients' preconditioner and gives Newton's directions, neither of which needs more
-// than single precision (the energy, gradient and line search stay in double); the solves read half
-// the bytes, and a solve is bound by reading the factor: the sphere scene at n = 64 (1.2 million
-// entries in its factor) spent 0.67-0.75 s in its solves against 1.97 s in CHOLMOD's, the same
-// solves in double precision here 1.31-1.55 s (docs/cloth.md).
+// CHOLMOD's symbolic analysis (its ordering, supernodes and their rows), then the numeric
+// factorisation and the triangular solves on both cores (sim::SupernodalFactorisation: the
+// subtrees below the top separators side by side, the same result to the bit on any number of
+// threads; the solves on the factor rounded to single precision). CHOLMOD factorises and solves
+// where the analysis is not one that allows it (CHOLMOD's solve into storage kept from call to call:
+// Eigen's solve() has CHOLMOD allocate the result and its workspace at every call).
 class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
  public:
   Cholesky() = default;
@@ -199,16 +194,9 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
     cholmod_free_dense(&y_, &cholmod());
     cholmod_free_dense(&e_, &cholmod());
   }
-  // out = A^-1 rhs with the last factorisation (out sized like rhs).
-  void solve_into(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
-    cholmod_dense b = Eigen::viewAsCholmod(const_cast<Eigen::VectorXd&>(rhs));  // read only
-    if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &b, nullptr, &x_, nullptr, &y_, &e_, &cholmod()))
-      throw std::runtime_error("implicit solver: CHOLMOD could not solve with its factorisation");
-    out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x_->x), rhs.size());
-  }
 
   // After analyzePattern: the factor's values allocated, and the factorisation on both cores
-  // prepared where its pattern allows (sim::SupernodalFactorisation).
+  // prepared where the analysis allows.
   void prepare_factorisation(const SparseMatrix& a) {
     parallel_.clear();
     cholmod_factor* f = m_cholmodFactor;
@@ -218,8 +206,7 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
       return;
     parallel_.analyse(*f, a.outerIndexPtr(), a.innerIndexPtr());
   }
-  // factorize(a), with the subtrees of its elimination tree on up to `threads` threads (the same
-  // factor to the bit on any number).
+  // factorize(a), on up to `threads` threads.
   void factorise(const SparseMatrix& a, int threads) {
     if (!parallel_.ready()) {
       const CholmodCall call;
@@ -234,65 +221,21 @@ class Cholesky : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> 
     m_info = parallel_.factorise(*m_cholmodFactor, a.valuePtr(), threads) ? Eigen::Success : Eigen::NumericalIssue;
     m_factorizationIsOk = true;
   }
-
-  // The factor's values rounded to single precision for solve_single, after each factorize (a
-  // factor CHOLMOD did not make supernodal is solved by solve_into).
-  void round_factor() {
-    const cholmod_factor* f = m_cholmodFactor;
-    if (!f || !f->is_super || f->xtype != CHOLMOD_REAL) {
-      single_.clear();
+  // out = A^-1 rhs with the last factorisation (out sized like rhs), on up to `threads` threads.
+  void solve_into(const Eigen::VectorXd& rhs, Eigen::VectorXd& out, int threads) {
+    if (parallel_.ready()) {
+      parallel_.solve(rhs.data(), out.data(), threads);
       return;
     }
-    const size_t count = static_cast<const int*>(f->px)[f->nsuper];
-    single_.resize(count);
-    const double* x = static_cast<const double*>(f->x);
-    for (size_t k = 0; k < count; ++k) single_[k] = static_cast<float>(x[k]);
-    work_.resize(f->n);
-    gather_.resize(f->maxesize);
-  }
-  bool has_single() const { return !single_.empty(); }
-  void forget_single() { single_.clear(); }
-  // out = A^-1 rhs with the single-precision factor: supernode by supernode, forward then back.
-  void solve_single(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
-    const cholmod_factor* f = m_cholmodFactor;
-    const int* super = static_cast<const int*>(f->super);
-    const int* pi = static_cast<const int*>(f->pi);
-    const int* px = static_cast<const int*>(f->px);
-    const int* rows = static_cast<const int*>(f->s);
-    const int* perm = static_cast<const int*>(f->Perm);
-    const size_t n = f->n;
-    float* y = work_.data();
-    float* t = gather_.data();
-    for (size_t k = 0; k < n; ++k) y[k] = static_cast<float>(rhs[perm[k]]);
-    using Block = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
-    for (size_t sn = 0; sn < f->nsuper; ++sn) {
-      const int k1 = super[sn], ncol = super[sn + 1] - k1, nrow = pi[sn + 1] - pi[sn], nbelow = nrow - ncol;
-      const float* l = single_.data() + px[sn];
-      Eigen::Map<Eigen::VectorXf> yc(y + k1, ncol);
-      Block(l, ncol, ncol, Eigen::OuterStride<>(nrow)).triangularView<Eigen::Lower>().solveInPlace(yc);
-      if (nbelow == 0) continue;
-      Eigen::Map<Eigen::VectorXf> tv(t, nbelow);
-      tv.noalias() = Block(l + ncol, nbelow, ncol, Eigen::OuterStride<>(nrow)) * yc;
-      const int* r = rows + pi[sn] + ncol;
-      for (int i = 0; i < nbelow; ++i) y[r[i]] -= t[i];
-    }
-    for (size_t sn = f->nsuper; sn-- > 0;) {
-      const int k1 = super[sn], ncol = super[sn + 1] - k1, nrow = pi[sn + 1] - pi[sn], nbelow = nrow - ncol;
-      const float* l = single_.data() + px[sn];
-      Eigen::Map<Eigen::VectorXf> yc(y + k1, ncol);
-      if (nbelow > 0) {
-        const int* r = rows + pi[sn] + ncol;
-        for (int i = 0; i < nbelow; ++i) t[i] = y[r[i]];
-        yc.noalias() -= Block(l + ncol, nbelow, ncol, Eigen::OuterStride<>(nrow)).transpose() * Eigen::Map<const Eigen::VectorXf>(t, nbelow);
-      }
-      Block(l, ncol, ncol, Eigen::OuterStride<>(nrow)).transpose().triangularView<Eigen::Upper>().solveInPlace(yc);
-    }
-    for (size_t k = 0; k < n; ++k) out[perm[k]] = static_cast<double>(y[k]);
+    const CholmodCall call;
+    cholmod_dense b = Eigen::viewAsCholmod(const_cast<Eigen::VectorXd&>(rhs));  // read only
+    if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &b, nullptr, &x_, nullptr, &y_, &e_, &cholmod()))
+      throw std::runtime_error("implicit solver: CHOLMOD could not solve with its factorisation");
+    out = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(x_->x), rhs.size());
   }
 
  private:
-  cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // result and workspace
-  std::vector<float> single_, work_, gather_;
+  cholmod_dense *x_ = nullptr, *y_ = nullptr, *e_ = nullptr;  // CHOLMOD's result and workspace
   sim::SupernodalFactorisation parallel_;
 };
 
@@ -503,16 +446,9 @@ struct ImplicitSolver::Impl {
   enum class Solve : uint8_t { Reached, Missed, Indefinite };
   Solve preconditioned_solve(double tolerance, int iterations);
   uint64_t triangular_solves = 0;  // since construction
-  // out = A^-1 rhs with the current factorisation (in single precision; CHOLMOD's, under the BLAS
-  // lock, where the factor is not supernodal).
+  // out = A^-1 rhs with the current factorisation (Cholesky::solve_into).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
-    if (cholesky.has_single()) {
-      cholesky.solve_single(rhs, out);
-      ++triangular_solves;
-      return;
-    }
-    const CholmodCall call;
-    cholesky.solve_into(rhs, out);
+    cholesky.solve_into(rhs, out, omp_get_max_threads());
     ++triangular_solves;
   }
 
@@ -787,7 +723,6 @@ void ImplicitSolver::Impl::analyse_pattern() {
     c.nrelax[1] = kRelaxMostlyZeros;
     c.nrelax[2] = kRelaxFewZeros;
     cholesky.analyzePattern(matrix);
-    cholesky.forget_single();
     cholesky.prepare_factorisation(matrix);
   }
 }
@@ -1644,7 +1579,6 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
         w.assemble(s, hd);
         w.cholesky.factorise(w.matrix, omp_get_max_threads());
       }
-      if (w.cholesky.info() == Eigen::Success) w.cholesky.round_factor();
       timer.mark(profile ? profile->factorize : scratch_time);
       if (w.cholesky.info() != Eigen::Success) {
         state.status = StepStatus::NonFinite;

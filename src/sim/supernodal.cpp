@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <array>
 #include <numeric>
@@ -187,7 +188,19 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   for (Workspace& w : work_) {
     w.relative.assign(static_cast<size_t>(n_), 0);
     w.update.assign(largest_update, 0.0);
+    w.gather.assign(std::max<size_t>(f.maxesize, 1), 0.0f);
+    w.carried.assign(static_cast<size_t>(n_), 0.0f);
   }
+  single_.assign(f.xsize, 0.0f);
+  y_.assign(static_cast<size_t>(n_), 0.0f);
+  top_row_.assign(static_cast<size_t>(n_), 0);
+  top_rows_.clear();
+  for (const int s : top_nodes_)
+    for (int k = v.super[s]; k < v.super[s + 1]; ++k) {
+      top_row_[static_cast<size_t>(k)] = 1;
+      top_rows_.push_back(k);
+    }
+  factor_ = &f;
   ready_ = true;
   return true;
 }
@@ -222,7 +235,7 @@ void SupernodalFactorisation::sum_updates(const cholmod_factor& f, int s, int pa
     if (part_[static_cast<size_t>(updates_[k].from)] == part) apply(f, s, updates_[k], into, 1.0, work);
 }
 
-int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* values, Workspace& work) const {
+int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* values, Workspace& work) {
   const View v(f);
   const int columns = v.columns(s), height = v.height(s), below = height - columns;
   double* l = static_cast<double*>(f.x) + v.px[s];
@@ -248,6 +261,7 @@ int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* v
     const double one = 1;
     dtrsm_("R", "L", "T", "N", &below, &columns, &one, l, &height, l + columns, &height, 1, 1, 1, 1);
   }
+  std::copy(l, l + size, single_.begin() + v.px[s]);
   return -1;
 }
 
@@ -279,6 +293,66 @@ bool SupernodalFactorisation::factorise(cholmod_factor& f, const double* values,
     }
   f.minor = f.n;
   return true;
+}
+
+
+using FloatBlock = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
+
+void SupernodalFactorisation::forward(int s, float* y, float* carried, float* gather) const {
+  const View v(*factor_);
+  const int k1 = v.super[s], columns = v.columns(s), height = v.height(s), below = height - columns;
+  const float* l = single_.data() + v.px[s];
+  Eigen::Map<Eigen::VectorXf> ys(y + k1, columns);
+  FloatBlock(l, columns, columns, Eigen::OuterStride<>(height)).triangularView<Eigen::Lower>().solveInPlace(ys);
+  if (below == 0) return;
+  Eigen::Map<Eigen::VectorXf> t(gather, below);
+  t.noalias() = FloatBlock(l + columns, below, columns, Eigen::OuterStride<>(height)) * ys;
+  const int* r = v.rows + v.pi[s] + columns;
+  for (int i = 0; i < below; ++i) {
+    if (carried && top_row_[static_cast<size_t>(r[i])]) carried[r[i]] += t[i];
+    else y[r[i]] -= t[i];
+  }
+}
+
+void SupernodalFactorisation::backward(int s, float* y, float* gather) const {
+  const View v(*factor_);
+  const int k1 = v.super[s], columns = v.columns(s), height = v.height(s), below = height - columns;
+  const float* l = single_.data() + v.px[s];
+  Eigen::Map<Eigen::VectorXf> ys(y + k1, columns);
+  if (below > 0) {
+    const int* r = v.rows + v.pi[s] + columns;
+    for (int i = 0; i < below; ++i) gather[i] = y[r[i]];
+    ys.noalias() -= FloatBlock(l + columns, below, columns, Eigen::OuterStride<>(height)).transpose() *
+                    Eigen::Map<const Eigen::VectorXf>(gather, below);
+  }
+  FloatBlock(l, columns, columns, Eigen::OuterStride<>(height)).transpose().triangularView<Eigen::Upper>().solveInPlace(ys);
+}
+
+// Forward (L y = P b): each part on its own, its updates to the top's rows carried apart and
+// subtracted part by part before the top's supernodes; back (L^T z = y): the top first, then each
+// part on its own (reading only its own rows and the top's). x = P^T z.
+void SupernodalFactorisation::solve(const double* b, double* x, int threads) {
+  const int* perm = static_cast<const int*>(factor_->Perm);
+  float* y = y_.data();
+  for (int k = 0; k < n_; ++k) y[k] = static_cast<float>(b[perm[k]]);
+  const int team = std::max(1, std::min(threads, kParts));
+#pragma omp parallel for num_threads(team) schedule(static, 1)
+  for (int p = 0; p < kParts; ++p) {
+    Workspace& work = work_[static_cast<size_t>(p)];
+    for (const int r : top_rows_) work.carried[static_cast<size_t>(r)] = 0.0f;
+    for (const int s : part_nodes_[static_cast<size_t>(p)]) forward(s, y, work.carried.data(), work.gather.data());
+  }
+  for (const int r : top_rows_)
+    for (const Workspace& work : work_) y[r] -= work.carried[static_cast<size_t>(r)];
+  for (const int s : top_nodes_) forward(s, y, nullptr, work_[0].gather.data());
+  for (auto s = top_nodes_.rbegin(); s != top_nodes_.rend(); ++s) backward(*s, y, work_[0].gather.data());
+#pragma omp parallel for num_threads(team) schedule(static, 1)
+  for (int p = 0; p < kParts; ++p) {
+    Workspace& work = work_[static_cast<size_t>(p)];
+    const std::vector<int>& nodes = part_nodes_[static_cast<size_t>(p)];
+    for (auto s = nodes.rbegin(); s != nodes.rend(); ++s) backward(*s, y, work.gather.data());
+  }
+  for (int k = 0; k < n_; ++k) x[perm[k]] = static_cast<double>(y[k]);
 }
 
 }  // namespace drape::sim

@@ -41,6 +41,12 @@ class SupernodalFactorisation {
   // definite (f->minor = the first column it failed at). `threads` 1 runs everything on the caller.
   bool factorise(cholmod_factor& f, const double* values, int threads);
 
+  // x = A^-1 b with the last factorisation's values rounded to single precision (b and x of
+  // length n, permuted here; they may not overlap), each part's supernodes on their own thread.
+  // The factor is a preconditioner and gives Newton's directions, neither of which needs more than
+  // single precision, and a triangular solve is bound by reading the factor: half the bytes.
+  void solve(const double* b, double* x, int threads);
+
   // The share of the flops outside the parts (on one thread), for the documentation's measurements.
   double top_share() const { return top_share_; }
 
@@ -51,10 +57,11 @@ class SupernodalFactorisation {
   struct Workspace {
     std::vector<int> relative;  // a row's position in the supernode being factorised
     std::vector<double> update;
+    std::vector<float> gather, carried;  // the solves': rows below a supernode; updates to the top's rows
   };
   // Factorises supernode s into its block of f's values: -1, or the column where dpotrf found the
   // matrix not positive definite.
-  int supernode(cholmod_factor& f, int s, const double* values, Workspace& work) const;
+  int supernode(cholmod_factor& f, int s, const double* values, Workspace& work);
   // The updates of part's supernodes to the top supernode s, summed into `into` (s's block's shape).
   void sum_updates(const cholmod_factor& f, int s, int part, double* into, Workspace& work) const;
   // target += sign * (update u to supernode s), on s's rows (work.relative set for s).
@@ -73,6 +80,13 @@ class SupernodalFactorisation {
   std::vector<size_t> sum_offset_;     // per (part, top supernode): its sum of updates in sums_
   std::vector<double> sums_;
   std::vector<Workspace> work_;
+  std::vector<float> single_;  // the factor's values rounded, supernode by supernode as they are made
+  std::vector<float> y_;       // the solves' permuted right-hand side and solution
+  std::vector<char> top_row_;  // per row: a top supernode's
+  std::vector<int> top_rows_;
+  void forward(int s, float* y, float* carried, float* gather) const;
+  void backward(int s, float* y, float* gather) const;
+  const cholmod_factor* factor_ = nullptr;
 };
 
 }  // namespace drape::sim

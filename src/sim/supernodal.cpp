@@ -178,9 +178,8 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   for (const int s : top_nodes_)
     for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
       const int p = part_[static_cast<size_t>(updates_[k].from)];
-      size_t& at = sum_offset_[static_cast<size_t>(p < 0 ? 0 : p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
-      if (p < 0 || at != SIZE_MAX) continue;
-      at = size;
+      if (p < 0 || sum_at(p, s) != SIZE_MAX) continue;
+      sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)] = size;
       size += static_cast<size_t>(v.height(s)) * static_cast<size_t>(v.columns(s));
     }
   sums_.assign(size, 0.0);
@@ -246,7 +245,7 @@ int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* v
   const int part = part_[static_cast<size_t>(s)];
   if (part < 0)
     for (int p = 0; p < kParts; ++p) {
-      const size_t at = sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+      const size_t at = sum_at(p, s);
       if (at == SIZE_MAX) continue;
       const double* sum = sums_.data() + at;
       for (size_t k = 0; k < size; ++k) l[k] -= sum[k];
@@ -276,7 +275,7 @@ bool SupernodalFactorisation::factorise(cholmod_factor& f, const double* values,
       if ((failed[static_cast<size_t>(p)] = supernode(f, s, values, work)) >= 0) break;
     if (failed[static_cast<size_t>(p)] < 0)
       for (const int s : top_nodes_) {
-        const size_t at = sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+        const size_t at = sum_at(p, s);
         if (at != SIZE_MAX) sum_updates(f, s, p, sums_.data() + at, work);
       }
   }

@@ -47,7 +47,7 @@ class SupernodalFactorisation {
   // single precision, and a triangular solve is bound by reading the factor: half the bytes.
   void solve(const double* b, double* x, int threads);
 
-  // The share of the flops outside the parts (on one thread), for the documentation's measurements.
+  // The share of the flops outside the parts (on one thread): the tests check it is a minority.
   double top_share() const { return top_share_; }
 
  private:
@@ -78,6 +78,9 @@ class SupernodalFactorisation {
   std::vector<uint32_t> entry_begin_;  // per supernode: A's lower entries in its columns
   std::vector<std::pair<uint32_t, uint32_t>> entries_;  // (index in A's values, index in its block)
   std::vector<size_t> sum_offset_;     // per (part, top supernode): its sum of updates in sums_
+  size_t sum_at(int part, int s) const {  // where part's sum for s starts in sums_, or SIZE_MAX
+    return sum_offset_[static_cast<size_t>(part) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)];
+  }
   std::vector<double> sums_;
   std::vector<Workspace> work_;
   std::vector<float> single_;  // the factor's values rounded, supernode by supernode as they are made

@@ -78,7 +78,8 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   std::partial_sum(entry_begin_.begin(), entry_begin_.end(), entry_begin_.begin());
 
   // Each supernode's updates, from the supernodes below whose rows reach its columns, in order; the
-  // elimination tree (a supernode's parent: the one its first row below reaches); the flops.
+  // elimination tree (a supernode's parent: the one its first row below reaches); the flops, each
+  // update's counted with the supernode it comes from (its part makes it).
   std::vector<std::vector<Update>> into(static_cast<size_t>(nsuper_));
   std::vector<int> parent(static_cast<size_t>(nsuper_), -1);
   std::vector<double> flops(static_cast<size_t>(nsuper_), 0.0);
@@ -94,7 +95,7 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
       into[static_cast<size_t>(s)].push_back({d, first, p});
       const size_t rows_reached = static_cast<size_t>(v.height(d) - first), columns_reached = static_cast<size_t>(p - first);
       largest_update = std::max(largest_update, rows_reached * columns_reached);
-      flops[static_cast<size_t>(s)] += static_cast<double>(rows_reached * columns_reached) * c;
+      flops[static_cast<size_t>(d)] += static_cast<double>(rows_reached * columns_reached) * c;
     }
   }
   update_begin_.assign(static_cast<size_t>(nsuper_) + 1, 0);
@@ -163,13 +164,6 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
       part_nodes_[static_cast<size_t>(part_[static_cast<size_t>(s)])].push_back(s);
     }
   }
-  // The updates from a part to a top supernode are the part's work: back out of the top's share.
-  for (const int s : top_nodes_)
-    for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
-      const Update& u = updates_[k];
-      if (part_[static_cast<size_t>(u.from)] >= 0)
-        top_flops -= static_cast<double>(v.height(u.from) - u.first) * (u.end - u.first) * v.columns(u.from);
-    }
   top_share_ = all_flops > 0 ? top_flops / all_flops : 0;
 
   // Where each part sums its updates to each top supernode.
@@ -190,6 +184,16 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
     w.gather.assign(std::max<size_t>(f.maxesize, 1), 0.0f);
     w.carried.assign(static_cast<size_t>(n_), 0.0f);
   }
+  size_t most_tasks = 0;
+  tiled_ = 0;
+  for (const int s : top_nodes_)
+    if (v.columns(s) >= kTiled) {
+      ++tiled_;
+      const size_t tiles = static_cast<size_t>((v.columns(s) + kTile - 1) / kTile);
+      most_tasks = std::max(most_tasks, tiles * (2 + static_cast<size_t>(v.height(s) / kRows)));
+    }
+  tasks_.clear();
+  tasks_.reserve(most_tasks);
   single_.assign(f.xsize, 0.0f);
   y_.assign(static_cast<size_t>(n_), 0.0f);
   top_row_.assign(static_cast<size_t>(n_), 0);
@@ -204,25 +208,23 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   return true;
 }
 
-void SupernodalFactorisation::apply(const cholmod_factor& f, int s, const Update& u, double* target, double sign,
-                                    Workspace& work) const {
+void SupernodalFactorisation::apply(const cholmod_factor& f, int s, const Update& u, int ja, int jb, double* target,
+                                    double sign, double* buffer, const int* relative) const {
   const View v(f);
   const double* x = static_cast<const double*>(f.x);
   const int d = u.from, columns = v.columns(d), height = v.height(d);
-  const int reached = u.end - u.first, rows = height - u.first, rest = rows - reached;
+  const int reached = jb - ja, rows = height - ja, rest = rows - reached;
   const double* l = x + v.px[d];
-  double* c = work.update.data();
   const double one = 1, zero = 0;
-  dsyrk_("L", "N", &reached, &columns, &one, l + u.first, &height, &zero, c, &rows, 1, 1);
+  dsyrk_("L", "N", &reached, &columns, &one, l + ja, &height, &zero, buffer, &rows, 1, 1);
   if (rest > 0)
-    dgemm_("N", "T", &rest, &reached, &columns, &one, l + u.end, &height, l + u.first, &height, &zero, c + reached, &rows,
+    dgemm_("N", "T", &rest, &reached, &columns, &one, l + jb, &height, l + ja, &height, &zero, buffer + reached, &rows,
            1, 1);
-  const int* r = v.rows + v.pi[d] + u.first;
+  const int* r = v.rows + v.pi[d] + ja;
   const int first_column = v.super[s], target_height = v.height(s);
-  const int* relative = work.relative.data();
   for (int j = 0; j < reached; ++j) {
     double* t = target + static_cast<size_t>(r[j] - first_column) * static_cast<size_t>(target_height);
-    const double* cj = c + static_cast<size_t>(j) * static_cast<size_t>(rows);
+    const double* cj = buffer + static_cast<size_t>(j) * static_cast<size_t>(rows);
     for (int i = j; i < rows; ++i) t[relative[r[i]]] += sign * cj[i];
   }
 }
@@ -230,29 +232,40 @@ void SupernodalFactorisation::apply(const cholmod_factor& f, int s, const Update
 void SupernodalFactorisation::sum_updates(const cholmod_factor& f, int s, int part, double* into, Workspace& work) const {
   const View v(f);
   for (int k = 0; k < v.height(s); ++k) work.relative[static_cast<size_t>(v.rows[v.pi[s] + k])] = k;
-  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k)
-    if (part_[static_cast<size_t>(updates_[k].from)] == part) apply(f, s, updates_[k], into, 1.0, work);
+  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
+    const Update& u = updates_[k];
+    if (part_[static_cast<size_t>(u.from)] == part)
+      apply(f, s, u, u.first, u.end, into, 1.0, work.update.data(), work.relative.data());
+  }
+}
+
+void SupernodalFactorisation::assemble(const cholmod_factor& f, int s, const double* values, double* l) const {
+  const View v(f);
+  const size_t size = static_cast<size_t>(v.height(s)) * static_cast<size_t>(v.columns(s));
+  std::fill(l, l + size, 0.0);
+  for (uint32_t k = entry_begin_[static_cast<size_t>(s)]; k < entry_begin_[static_cast<size_t>(s) + 1]; ++k)
+    l[entries_[k].second] += values[entries_[k].first];
+  if (part_[static_cast<size_t>(s)] >= 0) return;
+  for (int p = 0; p < kParts; ++p) {
+    const size_t at = sum_at(p, s);
+    if (at == SIZE_MAX) continue;
+    const double* sum = sums_.data() + at;
+    for (size_t k = 0; k < size; ++k) l[k] -= sum[k];
+  }
 }
 
 int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* values, Workspace& work) {
   const View v(f);
   const int columns = v.columns(s), height = v.height(s), below = height - columns;
   double* l = static_cast<double*>(f.x) + v.px[s];
-  const size_t size = static_cast<size_t>(height) * static_cast<size_t>(columns);
-  std::fill(l, l + size, 0.0);
-  for (uint32_t k = entry_begin_[static_cast<size_t>(s)]; k < entry_begin_[static_cast<size_t>(s) + 1]; ++k)
-    l[entries_[k].second] += values[entries_[k].first];
+  assemble(f, s, values, l);
   const int part = part_[static_cast<size_t>(s)];
-  if (part < 0)
-    for (int p = 0; p < kParts; ++p) {
-      const size_t at = sum_at(p, s);
-      if (at == SIZE_MAX) continue;
-      const double* sum = sums_.data() + at;
-      for (size_t k = 0; k < size; ++k) l[k] -= sum[k];
-    }
   for (int k = 0; k < height; ++k) work.relative[static_cast<size_t>(v.rows[v.pi[s] + k])] = k;
-  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k)
-    if (part_[static_cast<size_t>(updates_[k].from)] == part) apply(f, s, updates_[k], l, -1.0, work);
+  for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
+    const Update& u = updates_[k];
+    if (part_[static_cast<size_t>(u.from)] == part)
+      apply(f, s, u, u.first, u.end, l, -1.0, work.update.data(), work.relative.data());
+  }
   int info = 0;
   dpotrf_("L", &columns, l, &height, &info, 1);
   if (info != 0) return v.super[s] + info - 1;
@@ -260,7 +273,73 @@ int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* v
     const double one = 1;
     dtrsm_("R", "L", "T", "N", &below, &columns, &one, l, &height, l + columns, &height, 1, 1, 1, 1);
   }
-  std::copy(l, l + size, single_.begin() + v.px[s]);
+  std::copy(l, l + static_cast<size_t>(height) * static_cast<size_t>(columns), single_.begin() + v.px[s]);
+  return -1;
+}
+
+int SupernodalFactorisation::tiled_supernode(cholmod_factor& f, int s, const double* values, int threads) {
+  const View v(f);
+  const int columns = v.columns(s), height = v.height(s), tiles = (columns + kTile - 1) / kTile;
+  double* l = static_cast<double*>(f.x) + v.px[s];
+  assemble(f, s, values, l);
+  int* relative = work_[0].relative.data();
+  for (int k = 0; k < height; ++k) relative[v.rows[v.pi[s] + k]] = k;
+  const auto at = [&](int row, int column) { return l + static_cast<size_t>(column) * static_cast<size_t>(height) + row; };
+  int failed = -1;
+#pragma omp parallel num_threads(std::max(1, std::min(threads, kParts)))
+  {
+    double* buffer = work_[static_cast<size_t>(omp_get_thread_num())].update.data();
+    // The updates of the top's supernodes below (the parts' are summed in already), tile by tile of
+    // s's columns, each tile's in the updates' order.
+#pragma omp for schedule(dynamic, 1)
+    for (int t = 0; t < tiles; ++t) {
+      const int c0 = v.super[s] + t * kTile, c1 = std::min(v.super[s + 1], c0 + kTile);
+      for (uint32_t k = update_begin_[static_cast<size_t>(s)]; k < update_begin_[static_cast<size_t>(s) + 1]; ++k) {
+        const Update& u = updates_[k];
+        if (part_[static_cast<size_t>(u.from)] >= 0) continue;
+        const int* r = v.rows + v.pi[u.from];
+        const int ja = static_cast<int>(std::lower_bound(r + u.first, r + u.end, c0) - r);
+        const int jb = static_cast<int>(std::lower_bound(r + ja, r + u.end, c1) - r);
+        if (ja < jb) apply(f, s, u, ja, jb, l, -1.0, buffer, relative);
+      }
+    }
+    for (int t = 0; t < tiles; ++t) {
+      const int k0 = t * kTile, kc = std::min(kTile, columns - k0), k1 = k0 + kc;
+#pragma omp single
+      {
+        int info = 0;
+        dpotrf_("L", &kc, at(k0, k0), &height, &info, 1);
+        if (info != 0) failed = v.super[s] + k0 + info - 1;
+        // The next steps' tasks: each tile to the right, its diagonal block and its rows below in blocks.
+        tasks_.clear();
+        for (int j0 = k1; j0 < columns; j0 += kTile)
+          for (int r0 = j0; r0 < height; r0 += r0 == j0 ? std::min(kTile, columns - j0) : kRows) tasks_.emplace_back(j0, r0);
+      }
+      if (failed >= 0) break;
+      const int below = height - k1, blocks = (below + kRows - 1) / kRows;
+#pragma omp for schedule(dynamic, 1)
+      for (int b = 0; b < blocks; ++b) {
+        const int r0 = k1 + b * kRows, rows = std::min(kRows, height - r0);
+        const double one = 1;
+        dtrsm_("R", "L", "T", "N", &rows, &kc, &one, at(k0, k0), &height, at(r0, k0), &height, 1, 1, 1, 1);
+      }
+#pragma omp for schedule(dynamic, 1)
+      for (size_t k = 0; k < tasks_.size(); ++k) {
+        const auto [j0, r0] = tasks_[k];
+        const int jc = std::min(kTile, columns - j0);
+        const double minus = -1, one = 1;
+        if (r0 == j0) {
+          dsyrk_("L", "N", &jc, &kc, &minus, at(j0, k0), &height, &one, at(j0, j0), &height, 1, 1);
+        } else {
+          const int rows = std::min(kRows, height - r0);
+          dgemm_("N", "T", &rows, &jc, &kc, &minus, at(r0, k0), &height, at(j0, k0), &height, &one, at(r0, j0), &height,
+                 1, 1);
+        }
+      }
+    }
+  }
+  if (failed >= 0) return failed;
+  std::copy(l, l + static_cast<size_t>(height) * static_cast<size_t>(columns), single_.begin() + v.px[s]);
   return -1;
 }
 
@@ -286,7 +365,9 @@ bool SupernodalFactorisation::factorise(cholmod_factor& f, const double* values,
       return false;
     }
   for (const int s : top_nodes_)
-    if (const int column = supernode(f, s, values, work_[0]); column >= 0) {
+    if (const int column = View(f).columns(s) >= kTiled ? tiled_supernode(f, s, values, threads)
+                                                        : supernode(f, s, values, work_[0]);
+        column >= 0) {
       f.minor = static_cast<size_t>(column);
       return false;
     }

@@ -16,6 +16,11 @@
 // each part is factorised on its own, with the sum of its updates to each top supernode; then the
 // top, in order, each top supernode taking the parts' sums in part order. The parts are fixed by
 // the pattern, so the arithmetic, and the factor to the bit, are the same on any number of threads.
+//
+// The top's large supernodes (the separators at the root, dense blocks hundreds of columns wide)
+// are factorised in tiles of kTile columns, right-looking: a tile's dpotrf on one thread, then the
+// dtrsm of the rows below it and the updates of the tiles to its right spread over both threads.
+// The tiles, too, are fixed by the pattern: the same arithmetic on any number of threads.
 #include <cholmod.h>
 
 #include <cstddef>
@@ -28,6 +33,9 @@ namespace drape::sim {
 class SupernodalFactorisation {
  public:
   static constexpr int kParts = 2;
+  // The top's supernodes of at least kTiled columns are factorised in tiles of kTile columns, their
+  // rows below in blocks of kRows.
+  static constexpr int kTile = 64, kTiled = 2 * kTile, kRows = 128;
 
   // Prepares for a supernodal LL^T symbolic factor `f` of the n x n symmetric matrix whose
   // compressed columns are (outer, inner) (both triangles or the lower one: entries above the
@@ -47,8 +55,10 @@ class SupernodalFactorisation {
   // single precision, and a triangular solve is bound by reading the factor: half the bytes.
   void solve(const double* b, double* x, int threads);
 
-  // The share of the flops outside the parts (on one thread): the tests check it is a minority.
+  // The share of the flops in the top (outside the parts): the tests check it is a minority.
   double top_share() const { return top_share_; }
+  // How many of the top's supernodes are factorised in tiles.
+  int tiled_supernodes() const { return tiled_; }
 
  private:
   struct Update {
@@ -62,14 +72,21 @@ class SupernodalFactorisation {
   // Factorises supernode s into its block of f's values: -1, or the column where dpotrf found the
   // matrix not positive definite.
   int supernode(cholmod_factor& f, int s, const double* values, Workspace& work);
+  // The same for a top supernode of at least kTiled columns, in tiles on `threads` threads.
+  int tiled_supernode(cholmod_factor& f, int s, const double* values, int threads);
+  // A's entries in s's columns, less the parts' sums of updates to it (a top supernode), into l.
+  void assemble(const cholmod_factor& f, int s, const double* values, double* l) const;
   // The updates of part's supernodes to the top supernode s, summed into `into` (s's block's shape).
   void sum_updates(const cholmod_factor& f, int s, int part, double* into, Workspace& work) const;
-  // target += sign * (update u to supernode s), on s's rows (work.relative set for s).
-  void apply(const cholmod_factor& f, int s, const Update& u, double* target, double sign, Workspace& work) const;
+  // target += sign * (update u to supernode s), on s's rows (`relative` set for s), for the rows of
+  // u's supernode from ja and the columns of s its rows ja to jb reach (u.first <= ja < jb <= u.end).
+  void apply(const cholmod_factor& f, int s, const Update& u, int ja, int jb, double* target, double sign,
+             double* buffer, const int* relative) const;
 
   bool ready_ = false;
   int n_ = 0, nsuper_ = 0;
   double top_share_ = 0;
+  int tiled_ = 0;
   std::vector<int> part_;                    // per supernode: its part, or -1 (the top)
   std::vector<std::vector<int>> part_nodes_;  // per part: its supernodes in order
   std::vector<int> top_nodes_;
@@ -85,6 +102,7 @@ class SupernodalFactorisation {
   std::vector<Workspace> work_;
   std::vector<float> single_;  // the factor's values rounded, supernode by supernode as they are made
   std::vector<float> y_;       // the solves' permuted right-hand side and solution
+  std::vector<std::pair<int, int>> tasks_;  // a tiled supernode's updates of a step: (tile, first row)
   std::vector<char> top_row_;  // per row: a top supernode's
   std::vector<int> top_rows_;
   void forward(int s, float* y, float* carried, float* gather) const;

@@ -82,7 +82,8 @@ class Factor {
     cholmod_factorize(&view_, f, &common_);
     return f;
   }
-  cholmod_factor* ours(const Sparse& a, int threads, bool* positive = nullptr, double* top = nullptr) {
+  cholmod_factor* ours(const Sparse& a, int threads, bool* positive = nullptr, double* top = nullptr,
+                       int* tiled = nullptr) {
     cholmod_factor* f = cholmod_copy_factor(symbolic_, &common_);
     cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, f, &common_);
     SupernodalFactorisation s;
@@ -90,6 +91,7 @@ class Factor {
     const bool ok = s.factorise(*f, a.valuePtr(), threads);
     if (positive) *positive = ok;
     if (top) *top = s.top_share();
+    if (tiled) *tiled = s.tiled_supernodes();
     return f;
   }
   // |A x - b| / |b| for x solved with f.
@@ -103,6 +105,8 @@ class Factor {
     return (full - b).norm() / b.norm();
   }
   void free(cholmod_factor* f) { cholmod_free_factor(&f, &common_); }
+  // The unknown eliminated last (the last column of the top separator).
+  int last_eliminated() const { return static_cast<const int*>(symbolic_->Perm)[symbolic_->n - 1]; }
 
  private:
   cholmod_common common_{};
@@ -111,7 +115,7 @@ class Factor {
 };
 
 TEST(SupernodalFactorisation, SolvesAsCholmodDoes) {
-  for (const int side : {6, 30}) {
+  for (const int side : {6, 30, 70}) {
     Sparse a = grid_matrix(side, 7u + static_cast<uint32_t>(side));
     Factor factor(a);
     cholmod_factor* theirs = factor.cholmod();
@@ -122,7 +126,7 @@ TEST(SupernodalFactorisation, SolvesAsCholmodDoes) {
     EXPECT_EQ(ours->minor, ours->n);
     EXPECT_LT(factor.residual(theirs, a), 1e-12);
     EXPECT_LT(factor.residual(ours, a), 1e-12) << "side " << side;
-    if (side == 30) {
+    if (side >= 30) {
       EXPECT_LT(top, 0.5) << "the subtrees below the top separators should hold most of the work";
     }
     factor.free(theirs);
@@ -131,12 +135,16 @@ TEST(SupernodalFactorisation, SolvesAsCholmodDoes) {
 }
 
 TEST(SupernodalFactorisation, SameFactorBitForBitOnOneAndTwoThreads) {
-  Sparse a = grid_matrix(40, 3u);
+  // Large enough for the separators at the top to be factorised in tiles.
+  Sparse a = grid_matrix(70, 3u);
   Factor factor(a);
-  cholmod_factor* one = factor.ours(a, 1);
+  int tiled = 0;
+  cholmod_factor* one = factor.ours(a, 1, nullptr, nullptr, &tiled);
   cholmod_factor* two = factor.ours(a, 2);
+  EXPECT_GT(tiled, 0);
   ASSERT_EQ(one->xsize, two->xsize);
   EXPECT_EQ(std::memcmp(one->x, two->x, one->xsize * sizeof(double)), 0);
+  EXPECT_LT(factor.residual(two, a), 1e-12);
   factor.free(one);
   factor.free(two);
 }
@@ -151,6 +159,22 @@ TEST(SupernodalFactorisation, FindsAMatrixThatIsNotPositiveDefinite) {
   EXPECT_FALSE(positive);
   EXPECT_LT(ours->minor, ours->n);
   factor.free(ours);
+}
+
+TEST(SupernodalFactorisation, FindsAMatrixThatIsNotPositiveDefiniteInATiledSupernode) {
+  Sparse a = grid_matrix(70, 5u);
+  Factor factor(a);
+  const int last = factor.last_eliminated();
+  a.coeffRef(last, last) = -1e6;
+  for (const int threads : {1, 2}) {
+    bool positive = true;
+    int tiled = 0;
+    cholmod_factor* ours = factor.ours(a, threads, &positive, nullptr, &tiled);
+    EXPECT_GT(tiled, 0);
+    EXPECT_FALSE(positive);
+    EXPECT_EQ(ours->minor, ours->n - 1) << "the leading minors up to the last column are positive definite";
+    factor.free(ours);
+  }
 }
 
 }  // namespace

@@ -107,6 +107,10 @@ class SupernodalFactorisation {
   std::vector<int> top_rows_;
   void forward(int s, float* y, float* carried, float* gather) const;
   void backward(int s, float* y, float* gather) const;
+  // The same for a top supernode of at least kTiled columns, tile by tile, called by every thread
+  // of the team.
+  void tiled_forward(int s, float* y) const;
+  void tiled_backward(int s, float* y, float* gather) const;
   const cholmod_factor* factor_ = nullptr;
 };
 

@@ -186,8 +186,9 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   }
   size_t most_tasks = 0;
   tiled_ = 0;
+  factor_ = &f;
   for (const int s : top_nodes_)
-    if (v.columns(s) >= kTiled) {
+    if (tiled(s)) {
       ++tiled_;
       const size_t tiles = static_cast<size_t>((v.columns(s) + kTile - 1) / kTile);
       most_tasks = std::max(most_tasks, tiles * (2 + static_cast<size_t>(v.height(s) / kRows)));
@@ -203,7 +204,6 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
       top_row_[static_cast<size_t>(k)] = 1;
       top_rows_.push_back(k);
     }
-  factor_ = &f;
   ready_ = true;
   return true;
 }
@@ -276,6 +276,8 @@ int SupernodalFactorisation::supernode(cholmod_factor& f, int s, const double* v
   std::copy(l, l + static_cast<size_t>(height) * static_cast<size_t>(columns), single_.begin() + v.px[s]);
   return -1;
 }
+
+bool SupernodalFactorisation::tiled(int s) const { return View(*factor_).columns(s) >= kTiled; }
 
 int SupernodalFactorisation::tiled_supernode(cholmod_factor& f, int s, const double* values, int threads) {
   const View v(f);
@@ -365,8 +367,7 @@ bool SupernodalFactorisation::factorise(cholmod_factor& f, const double* values,
       return false;
     }
   for (const int s : top_nodes_)
-    if (const int column = View(f).columns(s) >= kTiled ? tiled_supernode(f, s, values, threads)
-                                                        : supernode(f, s, values, work_[0]);
+    if (const int column = tiled(s) ? tiled_supernode(f, s, values, threads) : supernode(f, s, values, work_[0]);
         column >= 0) {
       f.minor = static_cast<size_t>(column);
       return false;
@@ -408,70 +409,9 @@ void SupernodalFactorisation::backward(int s, float* y, float* gather) const {
   FloatBlock(l, columns, columns, Eigen::OuterStride<>(height)).transpose().triangularView<Eigen::Upper>().solveInPlace(ys);
 }
 
-void SupernodalFactorisation::tiled_forward(int s, float* y) const {
-  const View v(*factor_);
-  const int columns = v.columns(s), height = v.height(s);
-  const float* l = single_.data() + v.px[s];
-  const int* r = v.rows + v.pi[s];
-  Eigen::Map<Eigen::VectorXf> ys(y + v.super[s], columns);
-  for (int k0 = 0; k0 < columns; k0 += kTile) {
-    const int kc = std::min(kTile, columns - k0), k1 = k0 + kc, blocks = (height - k1 + kRows - 1) / kRows;
-    const float* tile = l + static_cast<size_t>(k0) * static_cast<size_t>(height);
-#pragma omp single
-    {
-      auto head = ys.segment(k0, kc);
-      FloatBlock(tile + k0, kc, kc, Eigen::OuterStride<>(height)).triangularView<Eigen::Lower>().solveInPlace(head);
-    }
-    // The rows below the tile, in blocks: each row's sum in the same order on any number of threads.
-#pragma omp for schedule(static)
-    for (int b = 0; b < blocks; ++b) {
-      const int i0 = k1 + b * kRows, rows = std::min(kRows, height - i0);
-      alignas(64) float t[kRows];
-      Eigen::Map<Eigen::VectorXf, Eigen::Aligned64>(t, rows).noalias() =
-          FloatBlock(tile + i0, rows, kc, Eigen::OuterStride<>(height)) * ys.segment(k0, kc);
-      for (int i = 0; i < rows; ++i) y[r[i0 + i]] -= t[i];
-    }
-  }
-}
-
-void SupernodalFactorisation::tiled_backward(int s, float* y, float* gather) const {
-  const View v(*factor_);
-  const int columns = v.columns(s), height = v.height(s), below = height - columns;
-  const float* l = single_.data() + v.px[s];
-  const int* r = v.rows + v.pi[s] + columns;
-  Eigen::Map<Eigen::VectorXf> ys(y + v.super[s], columns);
-  const auto block = [&](int row, int column, int rows, int cols) {
-    return FloatBlock(l + static_cast<size_t>(column) * static_cast<size_t>(height) + row, rows, cols,
-                      Eigen::OuterStride<>(height));
-  };
-  const int tiles = (columns + kTile - 1) / kTile;
-  if (below > 0) {
-#pragma omp single
-    for (int i = 0; i < below; ++i) gather[i] = y[r[i]];
-    // The rows below the supernode, for each tile of its columns.
-#pragma omp for schedule(static)
-    for (int t = 0; t < tiles; ++t) {
-      const int j0 = t * kTile, jc = std::min(kTile, columns - j0);
-      ys.segment(j0, jc).noalias() -= block(columns, j0, below, jc).transpose() * Eigen::Map<const Eigen::VectorXf>(gather, below);
-    }
-  }
-  // The diagonal block from its last tile up: each tile solved, then taken from the tiles before it.
-  for (int t = tiles - 1; t >= 0; --t) {
-    const int k0 = t * kTile, kc = std::min(kTile, columns - k0);
-#pragma omp single
-    {
-      auto head = ys.segment(k0, kc);
-      block(k0, k0, kc, kc).transpose().triangularView<Eigen::Upper>().solveInPlace(head);
-    }
-#pragma omp for schedule(static)
-    for (int j = 0; j < t; ++j) ys.segment(j * kTile, kTile).noalias() -= block(k0, j * kTile, kc, kTile).transpose() * ys.segment(k0, kc);
-  }
-}
-
 // Forward (L y = P b): each part on its own, its updates to the top's rows carried apart and
 // subtracted part by part before the top's supernodes; back (L^T z = y): the top first, then each
-// part on its own (reading only its own rows and the top's). x = P^T z. The top's large supernodes
-// go tile by tile, each tile's products spread over the threads.
+// part on its own (reading only its own rows and the top's). x = P^T z.
 void SupernodalFactorisation::solve(const double* b, double* x, int threads) {
   const int* perm = static_cast<const int*>(factor_->Perm);
   float* y = y_.data();
@@ -485,24 +425,8 @@ void SupernodalFactorisation::solve(const double* b, double* x, int threads) {
   }
   for (const int r : top_rows_)
     for (const Workspace& work : work_) y[r] -= work.carried[static_cast<size_t>(r)];
-#pragma omp parallel num_threads(team)
-  {
-    const View v(*factor_);
-    for (const int s : top_nodes_)
-      if (v.columns(s) >= kTiled) {
-        tiled_forward(s, y);
-      } else {
-#pragma omp single
-        forward(s, y, nullptr, work_[0].gather.data());
-      }
-    for (auto s = top_nodes_.rbegin(); s != top_nodes_.rend(); ++s)
-      if (v.columns(*s) >= kTiled) {
-        tiled_backward(*s, y, work_[0].gather.data());
-      } else {
-#pragma omp single
-        backward(*s, y, work_[0].gather.data());
-      }
-  }
+  for (const int s : top_nodes_) forward(s, y, nullptr, work_[0].gather.data());
+  for (auto s = top_nodes_.rbegin(); s != top_nodes_.rend(); ++s) backward(*s, y, work_[0].gather.data());
 #pragma omp parallel for num_threads(team) schedule(static, 1)
   for (int p = 0; p < kParts; ++p) {
     Workspace& work = work_[static_cast<size_t>(p)];

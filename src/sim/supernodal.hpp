@@ -74,6 +74,8 @@ class SupernodalFactorisation {
   int supernode(cholmod_factor& f, int s, const double* values, Workspace& work);
   // The same for a top supernode of at least kTiled columns, in tiles on `threads` threads.
   int tiled_supernode(cholmod_factor& f, int s, const double* values, int threads);
+  // Whether supernode s (of the top) is factorised in tiles.
+  bool tiled(int s) const;
   // A's entries in s's columns, less the parts' sums of updates to it (a top supernode), into l.
   void assemble(const cholmod_factor& f, int s, const double* values, double* l) const;
   // The updates of part's supernodes to the top supernode s, summed into `into` (s's block's shape).
@@ -107,10 +109,6 @@ class SupernodalFactorisation {
   std::vector<int> top_rows_;
   void forward(int s, float* y, float* carried, float* gather) const;
   void backward(int s, float* y, float* gather) const;
-  // The same for a top supernode of at least kTiled columns, tile by tile, called by every thread
-  // of the team.
-  void tiled_forward(int s, float* y) const;
-  void tiled_backward(int s, float* y, float* gather) const;
   const cholmod_factor* factor_ = nullptr;
 };
 

@@ -116,7 +116,8 @@ struct AnimationResult {
   double skinning_seconds = 0, collider_seconds = 0, measure_seconds = 0;
   ImplicitProfile profile;
   double time_step = 0;                    // s, the longest solver step
-  uint64_t solver_steps = 0;               // over all frames (per garment)
+  uint64_t solver_steps = 0;               // over all frames (per garment), retaken ones included
+  size_t frames_retaken = 0;               // frames taken again in shorter steps (past the strain gate)
   std::vector<float> friction;             // per garment: its Coulomb coefficient against the moving body
   std::optional<AnimatedSoftBody> soft_body;  // with DressOptions::soft_body
   std::optional<AnimatedSkinLayer> skin_layer;  // with AnimateOptions::skin_layer

@@ -422,6 +422,14 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
   r.simulation_seconds = r.skinning_seconds + (r.skin_layer && !soft ? r.skin_layer->seconds : 0.0);
   std::vector<float> moved(body.mesh.vertex_count());
   std::vector<uint8_t> near(body.mesh.vertex_count());
+  std::vector<ClothState> start_of_frame(ng);
+  const auto over_strain_gate = [&] {
+    for (size_t g = 0; g < ng; ++g) {
+      const ClothModel& model = r.dressed.garments[g].model;
+      if (strain_stats(model, states[g].x).max > model.fabric.strain_threshold + o.gates.strain_margin) return true;
+    }
+    return false;
+  };
   for (size_t f = 1; f < frames && r.status == StepStatus::Ok; ++f) {
     const auto frame_start = Clock::now();
     if (soft) {
@@ -435,20 +443,37 @@ AnimationResult animate(const Body& body, const std::vector<GarmentRequest>& gar
     float travel = 0;
     const VertexGrid grid(skin[f - 1], kNearCloth);
     for (size_t g = 0; g < ng; ++g) travel = std::max(travel, travel_near(grid, skin[f - 1], skin[f], states[g], near, moved));
-    const int steps = std::clamp(static_cast<int>(std::ceil(travel / std::max(o.max_body_step, 1e-4f))), o.substeps, kMaxStepsPerFrame);
+    int steps = std::clamp(static_cast<int>(std::ceil(travel / std::max(o.max_body_step, 1e-4f))), o.substeps, kMaxStepsPerFrame);
     bool converged = true;
     float residual = 0;
     int newton = 0;
-    for (int k = 0; k < steps && r.status == StepStatus::Ok; ++k)
-      for (size_t g = 0; g < ng && r.status == StepStatus::Ok; ++g) {
-        ImplicitStepStats stats;
-        settings[g].time_step = frame_time / steps;
-        r.status = solvers[g]->step(states[g], colliders[g], settings[g], &stats, &r.profile);
-        converged = converged && stats.converged;
-        newton += stats.newton_iterations;
-        if (k + 1 == steps) residual = std::max(residual, stats.residual);
-      }
-    r.solver_steps += static_cast<uint64_t>(steps);
+    for (size_t g = 0; g < ng; ++g) start_of_frame[g] = states[g];  // copies into the capacity kept
+    for (;;) {
+      converged = true;
+      residual = 0;
+      for (int k = 0; k < steps && r.status == StepStatus::Ok; ++k)
+        for (size_t g = 0; g < ng && r.status == StepStatus::Ok; ++g) {
+          ImplicitStepStats stats;
+          settings[g].time_step = frame_time / steps;
+          r.status = solvers[g]->step(states[g], colliders[g], settings[g], &stats, &r.profile);
+          converged = converged && stats.converged;
+          newton += stats.newton_iterations;
+          if (k + 1 == steps) residual = std::max(residual, stats.residual);
+        }
+      r.solver_steps += static_cast<uint64_t>(steps);
+      // A frame whose steps end with a spring stretched past the strain gate is taken again from
+      // its start in twice the steps. Its few Newton iterations a step leave what they did not
+      // settle to the next step, and a fast limb can pull a sleeve past the barrier within one;
+      // shorter steps move the body less in each, and the barrier's stiffness is met sooner.
+      if (r.status != StepStatus::Ok || steps >= kMaxStepsPerFrame || !over_strain_gate()) break;
+      for (size_t g = 0; g < ng; ++g) states[g] = start_of_frame[g];
+      // The colliders back to the frame's start, so that the first step's surface velocity is
+      // the body's over that step.
+      shared.update(states[0].time);
+      for (const std::unique_ptr<Collider>& layer : layers) layer->update(states[0].time);
+      steps = std::min(2 * steps, kMaxStepsPerFrame);
+      ++r.frames_retaken;
+    }
     if (soft && r.status == StepStatus::Ok) soft->give_way(skin[f], solvers, r.dressed.garments);
     r.simulation_seconds += seconds_since(frame_start);
     measure(f, converged, residual, newton);

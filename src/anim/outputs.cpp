@@ -197,6 +197,7 @@ std::string animation_report_json(const Motion& motion, const AnimationResult& r
                      {"time_step_s", r.time_step},
                      {"steps_per_frame_at_least", o.substeps},
                      {"solver_steps", r.solver_steps},
+                     {"frames_retaken", r.frames_retaken},
                      {"collision", std::string(to_string(o.collision))},
                      {"skinning", std::string(to_string(o.skinning))},
                      {"status", std::string(to_string(r.status))},

@@ -73,16 +73,16 @@ TEST(Animate, WalkingTwoSecondsKeepsTheShirtOnAndOutOfTheBody) {
 }
 
 // Running (3.5 m/s) moves the body 12 cm a frame: the solver takes more steps in such frames, so
-// the body does not pass through the shirt and leave it behind. The run's worst frame is chaotic in
-// the last bits of the vector code -march=native makes: its strain peak was under 9 % on Intel
-// Xeon machines and is 9.50 % (frame 29, the same on one and two threads) on AMD EPYC, so the
-// strain bound has a 5 % margin here (the walk's 2 %).
+// the body does not pass through the shirt and leave it behind. A frame that a fast limb still
+// stretches past the strain gate is taken again in shorter steps (its peak was chaotic in the last
+// bits of the vector code, 9.5 % on one build), so the run holds the walk's gates.
 TEST(Animate, ARunDoesNotTunnelThroughTheShirt) {
   const auto path = DRAPE_REQUIRE_SHARED("motions/cmu/cmu_09_01_run.bvh");
   if (sanitized()) GTEST_SKIP() << "sanitized build: the run is a Release test";
   const AnimationResult r = animate(female(), {{load_garment(default_garment_name()), ""}}, read_motion(path), quick_options(-1));
   EXPECT_GT(r.solver_steps, 4 * (r.frames.size() - 1));
-  expect_every_frame_within_gates(r, 0.02, 0.05f);
+  expect_every_frame_within_gates(r, 0.02, 0.02f);
+  EXPECT_TRUE(r.passed());
 }
 
 TEST(Animate, RaisingTheArmsKeepsTheShirtOnTheShoulders) {

@@ -1,0 +1,48 @@
+// A cloth-like sparse matrix for the factorisation's tests and benchmark (bench_factorise).
+#pragma once
+
+#include <Eigen/Sparse>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace drape::test {
+
+using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// A cloth-like matrix: a grid of side x side particles, 3 unknowns each, a mass on the diagonal
+// and a spring's stiffness k (I + u u^T) between neighbours, diagonals included (both triangles
+// stored, as the implicit solver stores its Hessian).
+inline Sparse grid_matrix(int side, uint32_t seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> stiffness(10.0, 1000.0), component(-1.0, 1.0);
+  const int n = side * side;
+  std::vector<Eigen::Triplet<double>> t;
+  const auto couple = [&](int a, int b) {
+    Eigen::Vector3d u(component(random), component(random), component(random));
+    u.normalize();
+    const Eigen::Matrix3d block = stiffness(random) * (Eigen::Matrix3d::Identity() + u * u.transpose());
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        t.emplace_back(3 * a + i, 3 * a + j, block(i, j));
+        t.emplace_back(3 * b + i, 3 * b + j, block(i, j));
+        t.emplace_back(3 * a + i, 3 * b + j, -block(i, j));
+        t.emplace_back(3 * b + i, 3 * a + j, -block(i, j));
+      }
+  };
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const int p = y * side + x;
+      for (int i = 0; i < 3; ++i) t.emplace_back(3 * p + i, 3 * p + i, 1.0);
+      if (x + 1 < side) couple(p, p + 1);
+      if (y + 1 < side) couple(p, p + side);
+      if (x + 1 < side && y + 1 < side) couple(p, p + side + 1);
+      if (x > 0 && y + 1 < side) couple(p, p + side - 1);
+    }
+  Sparse a(3 * n, 3 * n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  return a;
+}
+
+}  // namespace drape::test

@@ -27,6 +27,20 @@ namespace {
 // A partition is good enough once its largest part holds at most this much over an even share.
 constexpr double kBalance = 1.05;
 
+// v = `size` copies of `value`, its storage grown with room to spare: the pattern is analysed anew
+// whenever self-contact brings new blocks, its factor a little larger or smaller each time, and
+// storage made anew for each (tens of megabytes on the 20k-vertex shirt) cost more in the pages'
+// first touch than the rest of the analysis.
+template <class T, class A>
+void assign_with_room(std::vector<T, A>& v, size_t size, T value) {
+  if (v.capacity() < size) {
+    v.clear();
+    v.shrink_to_fit();
+    v.reserve(size + size / 4);
+  }
+  v.assign(size, value);
+}
+
 struct View {
   const int *super, *pi, *px, *rows;
   explicit View(const cholmod_factor& f)
@@ -55,7 +69,8 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
   const int* perm = static_cast<const int*>(f.Perm);
   std::vector<int> inverse(static_cast<size_t>(n_));
   for (int k = 0; k < n_; ++k) inverse[static_cast<size_t>(perm[k])] = k;
-  std::vector<std::array<uint32_t, 3>> placed;  // supernode, value index, block index
+  std::vector<std::array<uint32_t, 3>>& placed = placed_;  // supernode, value index, block index
+  placed.clear();
   for (int j = 0; j < n_; ++j)
     for (int q = outer[j]; q < outer[j + 1]; ++q) {
       const int i = inner[q];
@@ -68,14 +83,14 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
       placed.push_back({static_cast<uint32_t>(s), static_cast<uint32_t>(q),
                         static_cast<uint32_t>((col - v.super[s]) * v.height(s) + (at - r))});
     }
-  std::stable_sort(placed.begin(), placed.end(), [](const auto& x, const auto& y) { return x[0] < y[0]; });
+  // Grouped by supernode, in A's order within each (a counting sort: linear in A's entries, and
+  // the pattern is analysed anew whenever self-contact brings new blocks).
   entry_begin_.assign(static_cast<size_t>(nsuper_) + 1, 0);
-  entries_.clear();
-  for (const auto& [s, q, at] : placed) {
-    ++entry_begin_[s + 1];
-    entries_.emplace_back(q, at);
-  }
+  for (const auto& e : placed) ++entry_begin_[e[0] + 1];
   std::partial_sum(entry_begin_.begin(), entry_begin_.end(), entry_begin_.begin());
+  entries_.resize(placed.size());
+  std::vector<uint32_t> fill(entry_begin_.begin(), entry_begin_.end() - 1);
+  for (const auto& [s, q, at] : placed) entries_[fill[s]++] = {q, at};
 
   // Each supernode's updates, from the supernodes below whose rows reach its columns, in order; the
   // elimination tree (a supernode's parent: the one its first row below reaches); the flops, each
@@ -176,11 +191,11 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
       sum_offset_[static_cast<size_t>(p) * static_cast<size_t>(nsuper_) + static_cast<size_t>(s)] = size;
       size += static_cast<size_t>(v.height(s)) * static_cast<size_t>(v.columns(s));
     }
-  sums_.assign(size, 0.0);
+  assign_with_room(sums_, size, 0.0);
   work_.resize(kParts);
   for (Workspace& w : work_) {
     w.relative.assign(static_cast<size_t>(n_), 0);
-    w.update.assign(largest_update, 0.0);
+    assign_with_room(w.update, largest_update, 0.0);
     w.gather.assign(std::max<size_t>(f.maxesize, 1), 0.0f);
     w.carried.assign(static_cast<size_t>(n_), 0.0f);
   }
@@ -195,7 +210,7 @@ bool SupernodalFactorisation::analyse(const cholmod_factor& f, const int* outer,
     }
   tasks_.clear();
   tasks_.reserve(most_tasks);
-  single_.assign(f.xsize, 0.0f);
+  assign_with_room(single_, f.xsize, 0.0f);
   y_.assign(static_cast<size_t>(n_), 0.0f);
   top_row_.assign(static_cast<size_t>(n_), 0);
   top_rows_.clear();

@@ -23,6 +23,7 @@
 // The tiles, too, are fixed by the pattern: the same arithmetic on any number of threads.
 #include <cholmod.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -102,6 +103,7 @@ class SupernodalFactorisation {
   }
   std::vector<double> sums_;
   std::vector<Workspace> work_;
+  std::vector<std::array<uint32_t, 3>> placed_;  // analyse's: A's entries (supernode, value, block index)
   std::vector<float> single_;  // the factor's values rounded, supernode by supernode as they are made
   std::vector<float> y_;       // the solves' permuted right-hand side and solution
   std::vector<std::pair<int, int>> tasks_;  // a tiled supernode's updates of a step: (tile, first row)

@@ -34,19 +34,8 @@ void blas_on_one_thread() {
 class GridSystem {
  public:
   explicit GridSystem(int side) : a_(drape::test::grid_matrix(side, 7u + static_cast<uint32_t>(side))) {
-    cholmod_start(&common_);
-    common_.supernodal = CHOLMOD_SUPERNODAL;
-    common_.print = 0;
-    view_.nrow = view_.ncol = static_cast<size_t>(a_.rows());
-    view_.nzmax = static_cast<size_t>(a_.nonZeros());
-    view_.p = a_.outerIndexPtr();
-    view_.i = a_.innerIndexPtr();
-    view_.x = a_.valuePtr();
-    view_.stype = -1;  // the lower triangle
-    view_.itype = CHOLMOD_INT;
-    view_.xtype = CHOLMOD_REAL;
-    view_.dtype = CHOLMOD_DOUBLE;
-    view_.sorted = view_.packed = 1;
+    drape::test::start_supernodal(common_);
+    view_ = drape::test::lower_view(a_);
     factor_ = cholmod_analyze(&view_, &common_);
     cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, factor_, &common_);
     ours_.analyse(*factor_, a_.outerIndexPtr(), a_.innerIndexPtr());

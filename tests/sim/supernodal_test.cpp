@@ -22,19 +22,8 @@ using test::Sparse;
 class Factor {
  public:
   explicit Factor(Sparse& a) {
-    cholmod_start(&common_);
-    common_.supernodal = CHOLMOD_SUPERNODAL;
-    common_.print = 0;
-    view_.nrow = view_.ncol = static_cast<size_t>(a.rows());
-    view_.nzmax = static_cast<size_t>(a.nonZeros());
-    view_.p = a.outerIndexPtr();
-    view_.i = a.innerIndexPtr();
-    view_.x = a.valuePtr();
-    view_.stype = -1;  // the lower triangle
-    view_.itype = CHOLMOD_INT;
-    view_.xtype = CHOLMOD_REAL;
-    view_.dtype = CHOLMOD_DOUBLE;
-    view_.sorted = view_.packed = 1;
+    test::start_supernodal(common_);
+    view_ = test::lower_view(a);
     symbolic_ = cholmod_analyze(&view_, &common_);
   }
   ~Factor() {

@@ -1,5 +1,8 @@
-// A cloth-like sparse matrix for the factorisation's tests and benchmark (bench_factorise).
+// A cloth-like sparse matrix for the factorisation's tests and benchmark (bench_factorise), and
+// CHOLMOD's view of it.
 #pragma once
+
+#include <cholmod.h>
 
 #include <Eigen/Sparse>
 #include <cstdint>
@@ -43,6 +46,29 @@ inline Sparse grid_matrix(int side, uint32_t seed) {
   a.setFromTriplets(t.begin(), t.end());
   a.makeCompressed();
   return a;
+}
+
+// CHOLMOD's view of a's lower triangle (a's own storage), for its supernodal analysis.
+inline cholmod_sparse lower_view(Sparse& a) {
+  cholmod_sparse view{};
+  view.nrow = view.ncol = static_cast<size_t>(a.rows());
+  view.nzmax = static_cast<size_t>(a.nonZeros());
+  view.p = a.outerIndexPtr();
+  view.i = a.innerIndexPtr();
+  view.x = a.valuePtr();
+  view.stype = -1;  // the lower triangle
+  view.itype = CHOLMOD_INT;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  view.sorted = view.packed = 1;
+  return view;
+}
+
+// CHOLMOD started for a supernodal factorisation, quietly.
+inline void start_supernodal(cholmod_common& common) {
+  cholmod_start(&common);
+  common.supernodal = CHOLMOD_SUPERNODAL;
+  common.print = 0;
 }
 
 }  // namespace drape::test

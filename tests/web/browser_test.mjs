@@ -62,8 +62,9 @@ page.on('console', (m) => {
   if (m.type() === 'error' && !/status of 400/.test(m.text())) pageErrors.push(m.text());
 });
 const shot = (name) => page.screenshot({ path: path.join(outDir, name) });
+// A view is checked once the page has drawn it (data-drawn follows each frame rendered).
 const waitView = (view, timeout = 120000) =>
-  page.waitForSelector(`body[data-view="${view}"]`, { timeout });
+  page.waitForSelector(`body[data-view="${view}"][data-drawn="${view}"]`, { timeout });
 
 // Pixels of the 3D view near the hue of drape's skin tone and near the hue of the garment's colour
 // (shading changes their lightness, not their hue), as fractions of the view.
@@ -111,7 +112,6 @@ try {
   }
   await page.click('#make-body');
   await waitView('body', 60000);
-  await new Promise((r) => setTimeout(r, 500));
   const bodyPixels = await pixels(shirt.colour);
   check(bodyPixels.skin > 0.01, `the body is shown (${(100 * bodyPixels.skin).toFixed(1)} % skin)`);
   await shot('body.png');
@@ -120,10 +120,9 @@ try {
   await page.click('.card[data-garment="shirt"]');
   await page.click('#sizes button[data-size="M"]');
   await page.click('#tryon');
-  await page.waitForSelector('#progress:not([hidden])', { timeout: 10000 });
+  await page.waitForSelector('#progress:not([hidden])', { timeout: 60000 });
   check(true, 'progress is shown while dressing');
   await waitView('dressed');
-  await new Promise((r) => setTimeout(r, 800));
   const dressed = await pixels(shirt.colour);
   check(dressed.cloth > 0.01, `the shirt is shown in its colour (${(100 * dressed.cloth).toFixed(1)} % of the view)`);
   check(dressed.skin > 0.002, `the body shows beside it (${(100 * dressed.skin).toFixed(1)} % skin)`);
@@ -134,7 +133,6 @@ try {
   // The fit map: cloth and skin in drape's strain and pressure colours, with a legend.
   await page.click('#fitmap');
   await waitView('fitmap', 30000);
-  await new Promise((r) => setTimeout(r, 800));
   const fit = await pixels(shirt.colour);
   const legend = await page.$eval('#legend', (e) => (e.hidden ? '' : e.innerText));
   check(await page.$eval('#fitmap', (e) => e.getAttribute('aria-pressed')) === 'true', 'the fit-map button is pressed');

@@ -103,6 +103,9 @@ renderer.setAnimationLoop(() => {
   if (!redraw) return;
   redraw = false;
   renderer.render(scene, camera);
+  // What the canvas now shows: a page that reads the picture back (tests, screenshots) waits for
+  // this rather than for a time, which a slow software renderer can overrun.
+  document.body.dataset.drawn = document.body.dataset.view || '';
 });
 
 // Keyboard: arrows turn the body, +/- zoom, when the view has focus.
@@ -144,6 +147,7 @@ function show(root, label) {
   $('empty').hidden = !!root;
   requestRedraw();
   document.body.dataset.view = label;
+  delete document.body.dataset.drawn;
 }
 
 // ---- Body ----------------------------------------------------------------------------------------

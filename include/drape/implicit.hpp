@@ -126,6 +126,12 @@ struct ImplicitProfile {
   uint64_t steps = 0, newton_iterations = 0, factorizations = 0, line_search_halvings = 0;
   uint64_t triangular_solves = 0;  // with a factorisation: one per conjugate-gradient iteration and one to start them
   uint64_t block_sweeps = 0;
+  // Analyses of the sparse pattern: the first, and each time self-contact needed blocks the pattern
+  // lacked (below 4000 particles; from there such pairs are left out of the factorised matrix).
+  uint64_t analyses = 0;
+  // Self-contact pairs whose blocks the pattern lacks, summed over the assembled matrices (from 4000
+  // particles: in the conjugate gradients' products, not the factorised matrix).
+  uint64_t self_pairs_outside_pattern = 0;
   double total_seconds() const { return contacts + self_contacts + sweeps + assemble + factorize + solve + line_search; }
 };
 

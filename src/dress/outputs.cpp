@@ -80,6 +80,7 @@ std::string dress_report_json(const Body& body, const DressResult& r, const Dres
                         {"newton_iterations", g.implicit_profile.newton_iterations},
                         {"factorizations", g.implicit_profile.factorizations},
                         {"triangular_solves", g.implicit_profile.triangular_solves},
+                        {"pattern_analyses", g.implicit_profile.analyses},
                         {"initial_max_seam_gap_m", g.initial_max_gap},
                         {"max_seam_gap_m", gaps.max},
                         {"mean_seam_gap_m", gaps.mean},

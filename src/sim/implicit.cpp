@@ -923,6 +923,7 @@ double ImplicitSolver::Impl::self_terms(const std::vector<Vec3d>& at, bool with_
 }
 
 bool ImplicitSolver::Impl::add_self_blocks() {
+  if (reduced()) return false;  // the pairs the pattern lacks are loose_pairs
   needed_blocks.clear();
   bool missing = false;
   const double near = -self_thickness();
@@ -935,7 +936,7 @@ bool ImplicitSolver::Impl::add_self_blocks() {
         missing = missing || block_of(a, b) == kNoBlock;
       }
   }
-  if (!missing || reduced()) return false;
+  if (!missing) return false;
   // The pattern holds what the pairs near contact need now, and what it held before while that is
   // not much more than they need: pairs that come and go keep their blocks (the walking shirt
   // analysed its pattern 91 times in 85 frames so, 222 times when it held only what was needed

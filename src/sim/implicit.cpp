@@ -1510,8 +1510,12 @@ StepStatus ImplicitSolver::step(ClothState& state, std::span<Collider* const> co
     w.x[i] = w.free[i] ? w.x0[i] : w.y[i];
   }
   if (!w.analysed) {
+    // The first analysis (the ordering and the symbolic factorisation: 0.68 s of the 20k-vertex
+    // shirt's nested dissection) is the factorisation's.
+    timer.mark(profile ? profile->contacts : scratch_time);
     w.analyse_pattern();
     w.analysed = true;
+    timer.mark(profile ? profile->factorize : scratch_time);
   }
   // Colliders that move carry the cloth that lies on them: Newton's iterations start (the iterate
   // only: inertia and friction still measure from x_n) with a particle within the contact layer's

@@ -525,8 +525,8 @@ struct ImplicitSolver::Impl {
   // gradients on A preconditioned by the factorised P), a self-contact pair whose blocks the
   // pattern lacks is not analysed into it: P holds its majorant on the diagonal blocks and the
   // gradients' products the pair itself (hessian_product). A new analysis, each time self-contact
-  // met blocks the pattern lacked, was one thread's work: the 20k-vertex shirt analysed 28 times,
-  // 4.4 s of its 46 s on two threads.
+  // met blocks the pattern lacked, was one thread's work (the 20k-vertex shirt analysed 28 times,
+  // 4.4 s in all), and the blocks it added made the factor larger (docs/cloth.md).
   struct LoosePair {
     std::array<uint32_t, 4> node{};
     std::array<double, 4> a{};

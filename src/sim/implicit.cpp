@@ -405,14 +405,18 @@ struct ImplicitSolver::Impl {
     // Self-contact pairs whose blocks the pattern lacks: the matrix holds 4 diag(a^2) (x) K n n^T
     // for each (add_self_hessian); A holds a a^T (x) K n n^T.
     for (const LoosePair& lp : loose_pairs) {
+      const sim::SelfPair& pr = self_pairs[lp.pair];
+      const Tri& tri = model.triangles[pr.triangle];
+      const std::array<uint32_t, 4> node{pr.particle, tri[0], tri[1], tri[2]};
+      const std::array<double, 4> a{1.0, -pr.weight[0], -pr.weight[1], -pr.weight[2]};
       double along = 0;
       for (size_t j = 0; j < 4; ++j)
-        if (lp.free[j]) along += lp.a[j] * lp.normal.dot(v.segment<3>(static_cast<Eigen::Index>(3 * lp.node[j])));
+        if (free[node[j]]) along += a[j] * pr.normal.dot(v.segment<3>(static_cast<Eigen::Index>(3 * node[j])));
       for (size_t j = 0; j < 4; ++j) {
-        if (!lp.free[j]) continue;
-        const auto i = static_cast<Eigen::Index>(3 * lp.node[j]);
-        const double own = lp.normal.dot(v.segment<3>(i));
-        out.segment<3>(i) += (lp.k * lp.a[j] * (along - 4.0 * lp.a[j] * own)) * lp.normal;
+        if (!free[node[j]]) continue;
+        const auto i = static_cast<Eigen::Index>(3 * node[j]);
+        const double own = pr.normal.dot(v.segment<3>(i));
+        out.segment<3>(i) += (lp.k * a[j] * (along - 4.0 * a[j] * own)) * pr.normal;
       }
     }
   }
@@ -528,11 +532,8 @@ struct ImplicitSolver::Impl {
   // met blocks the pattern lacked, was one thread's work (the 20k-vertex shirt analysed 28 times,
   // 4.4 s in all), and the blocks it added made the factor larger (docs/cloth.md).
   struct LoosePair {
-    std::array<uint32_t, 4> node{};
-    std::array<double, 4> a{};
-    std::array<bool, 4> free{};
-    Vec3d normal = Vec3d::Zero();
-    double k = 0;  // the penalty's stiffness at the pair's depth
+    uint32_t pair = 0;  // into self_pairs
+    double k = 0;       // the penalty's stiffness at the pair's depth
   };
   std::vector<LoosePair> loose_pairs;  // assembled with the matrix
   bool reduced() const { return !far_pair.empty(); }
@@ -999,8 +1000,7 @@ void ImplicitSolver::Impl::add_self_hessian(double* values) {
       if (free[node[j]]) add_block(node[j], ((coupled ? 1.0 : 4.0) * a[j] * a[j]) * nn);
     if (!coupled) {
       if (reduced())
-        loose_pairs.push_back({node, a, {free[node[0]] != 0, free[node[1]] != 0, free[node[2]] != 0, free[node[3]] != 0},
-                               pr.normal, contact_stiffness(contact_k[pr.particle], d, kNoSkin)});
+        loose_pairs.push_back({static_cast<uint32_t>(&pr - self_pairs.data()), contact_stiffness(contact_k[pr.particle], d, kNoSkin)});
       continue;
     }
     e = 0;
